@@ -1,0 +1,260 @@
+/* bench.c - the packer's benchmark (not a test): the report's four cases (disks, density,
+ * fidelity, median time), the level-band option against the report's rule, and a scaling
+ * run on the Bagi law from 10^3 to 10^7 disks with disks per second and peak memory.
+ * Prints markdown. Usage: grainpack_bench [--quick] [--max-disks N] EXAMPLES_DIR */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "grainpack/pack.h"
+#include "grainpack/spec.h"
+#include "grainpack/stats.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, compare_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void load(const char *dir, const char *name, gp_spec *spec)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.json", dir, name);
+    gp_error err;
+    if (gp_spec_load_file(path, NULL, spec, &err)) {
+        fprintf(stderr, "%s: %s %s\n", path, err.pointer, err.message);
+        exit(1);
+    }
+}
+
+typedef struct case_result {
+    size_t disks;
+    double density, max_abs_z, median_ms;
+    gp_pack_stats stats; /* of the first run */
+} case_result;
+
+/* Packs the spec `runs` times with seed 1 (the same work each time) and keeps the median
+ * time; statistics come from the first run. */
+static case_result run_case(const gp_spec *spec, uint32_t band, int runs)
+{
+    case_result res;
+    memset(&res, 0, sizeof res);
+    double times[64];
+    for (int i = 0; i < runs; i++) {
+        gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, spec->seed, 0, band};
+        gp_packing pk;
+        gp_error err;
+        double t0 = now();
+        if (gp_pack(&params, NULL, &pk, &err)) {
+            fprintf(stderr, "pack failed: %s\n", err.message);
+            exit(1);
+        }
+        times[i] = now() - t0;
+        if (i == 0) {
+            gp_pack_stats_compute(&spec->domain, &spec->dist, &pk, &res.stats);
+            res.disks = pk.count;
+            res.density = res.stats.packing_density;
+            res.max_abs_z = res.stats.max_abs_z;
+        }
+        gp_packing_free(&pk);
+    }
+    res.median_ms = 1e3 * median(times, runs);
+    return res;
+}
+
+/* Mean density and worst |z| over seeds 1..seeds. */
+static void seed_average(const gp_spec *spec, uint32_t band, int seeds, double *mean, double *zmax)
+{
+    *mean = 0.0;
+    *zmax = 0.0;
+    for (int s = 1; s <= seeds; s++) {
+        gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, (uint64_t)s, 0, band};
+        gp_packing pk;
+        gp_error err;
+        if (gp_pack(&params, NULL, &pk, &err))
+            exit(1);
+        gp_pack_stats st;
+        gp_pack_stats_compute(&spec->domain, &spec->dist, &pk, &st);
+        *mean += st.packing_density / seeds;
+        if (st.max_abs_z > *zmax)
+            *zmax = st.max_abs_z;
+        gp_pack_stats_free(&st);
+        gp_packing_free(&pk);
+    }
+}
+
+static const struct {
+    const char *name;
+    const char *report; /* the report's figures (SPEC §3.6) */
+} cases[] = {
+    {"fixed", "2789 / 0.8762 / 0.04 s"},
+    {"variable", "1217 / 0.8019 / 0.02 s"},
+    {"iron", "987 / 0.80 / < 0.01 s"},
+    {"bagi", "~39000 / 0.84 / 6 s"},
+};
+
+static void print_machine(void)
+{
+    char model[256] = "unknown CPU";
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (f) {
+        char line[512];
+        while (fgets(line, sizeof line, f)) {
+            if (strncmp(line, "model name", 10) == 0) {
+                char *colon = strchr(line, ':');
+                if (colon) {
+                    snprintf(model, sizeof model, "%s", colon + 2);
+                    model[strcspn(model, "\n")] = '\0';
+                }
+                break;
+            }
+        }
+        fclose(f);
+    }
+#ifdef __OPTIMIZE__
+    const char *build = "optimised";
+#else
+    const char *build = "unoptimised";
+#endif
+    printf("Machine: %s, %ld cores online; one thread; %s build.\n\n", model,
+           sysconf(_SC_NPROCESSORS_ONLN), build);
+}
+
+static void bench_cases(const char *dir, int runs, int seeds)
+{
+    printf("### The report's four cases (seed 1, median of %d runs)\n\n", runs);
+    printf("| case | level band | disks | packing density | mean density, %d seeds | max abs z, %d seeds | median time | report: disks / density / time |\n",
+           seeds, seeds);
+    printf("|---|---|---|---|---|---|---|---|\n");
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        gp_spec spec;
+        load(dir, cases[c].name, &spec);
+        for (uint32_t band = 0; band <= 4; band += band ? 3 : 1) {
+            case_result r = run_case(&spec, band, runs);
+            double mean, zmax;
+            seed_average(&spec, band, seeds, &mean, &zmax);
+            printf("| %s | %u%s | %zu | %.4f | %.4f | %.2f | %.2f ms | %s |\n", cases[c].name, band,
+                   band == spec.level_band ? " (default)" : "", r.disks, r.density, mean, zmax,
+                   r.median_ms, band == 0 ? cases[c].report : "");
+            gp_pack_stats_free(&r.stats);
+        }
+        gp_spec_free(&spec);
+    }
+    printf("\n### Achieved versus target histogram (seed 1, default options)\n\n");
+    for (size_t c = 1; c < sizeof cases / sizeof cases[0]; c++) {
+        gp_spec spec;
+        load(dir, cases[c].name, &spec);
+        case_result r = run_case(&spec, spec.level_band, 1);
+        printf("**%s** (%zu disks, chi-square %.2f on %d dof, p = %.3f):\n\n", cases[c].name, r.disks,
+               r.stats.chi2, r.stats.dof, r.stats.p_value);
+        printf("| bin | target | achieved | z |\n|---|---|---|---|\n");
+        for (size_t b = 0; b < r.stats.nbins; b++)
+            printf("| [%g, %g) | %.4f | %.4f | %+.2f |\n", r.stats.bins[b].min, r.stats.bins[b].max,
+                   r.stats.bins[b].target, r.stats.bins[b].achieved, r.stats.bins[b].z);
+        printf("\n");
+        gp_pack_stats_free(&r.stats);
+        gp_spec_free(&spec);
+    }
+}
+
+/* One scaling point, in a child process so that its peak memory is its own. */
+static void scale_point(double target, uint32_t band)
+{
+    int fds[2];
+    if (pipe(fds))
+        exit(1);
+    pid_t pid = fork();
+    if (pid == 0) {
+        close(fds[0]);
+        struct rusage before, after;
+        getrusage(RUSAGE_SELF, &before);
+        gp_distribution dist = {.kind = GP_DIST_UNIFORM, .min = 0.06, .max = 0.42};
+        gp_joint joint = {GP_JOINT_NONE, 0, 0, 0};
+        /* the Bagi law fills about 0.79 of the domain with the report's rule: pick the
+         * square whose area holds `target` disks */
+        double side = sqrt(target * M_PI * gp_distribution_mean_packing_r2(&dist, &joint) / 0.79);
+        gp_domain dom = {side, side};
+        gp_pack_params params = {&dom, &dist, &joint, 1, 0, band};
+        gp_packing pk;
+        gp_error err;
+        double t0 = now();
+        int rc = gp_pack(&params, NULL, &pk, &err);
+        double t = now() - t0;
+        getrusage(RUSAGE_SELF, &after);
+        double bytes = (double)(after.ru_maxrss - before.ru_maxrss) * 1024.0;
+        char line[256];
+        int n = snprintf(line, sizeof line, "%d %zu %.6f %.0f %.4f\n", rc, pk.count, t, bytes,
+                         pk.fill_area / (side * side));
+        if (write(fds[1], line, (size_t)n) != n)
+            _exit(1);
+        _exit(0);
+    }
+    close(fds[1]);
+    char buf[256] = {0};
+    ssize_t got = read(fds[0], buf, sizeof buf - 1);
+    close(fds[0]);
+    waitpid(pid, NULL, 0);
+    int rc;
+    size_t count;
+    double t, bytes, density;
+    if (got <= 0 || sscanf(buf, "%d %zu %lf %lf %lf", &rc, &count, &t, &bytes, &density) != 5 || rc) {
+        printf("| %.0e | failed | | | | |\n", target);
+        return;
+    }
+    printf("| %u | %zu | %.4f | %.3f s | %.2f M/s | %.0f |\n", band, count, density, t,
+           (double)count / t / 1e6, bytes / (double)count);
+    fflush(stdout);
+}
+
+static void bench_scaling(double max_disks)
+{
+    printf("### Scaling on the Bagi law (uniform radii 0.06-0.42, no joint, seed 1)\n\n");
+    printf("Peak memory is the growth of the process's maximum resident set during the run.\n\n");
+    printf("| level band | disks | packing density | time | disks per second | peak bytes per disk |\n");
+    printf("|---|---|---|---|---|---|\n");
+    for (uint32_t band = 0; band <= 1; band++)
+        for (double n = 1e3; n <= max_disks * 1.01; n *= 10)
+            scale_point(n, band);
+    printf("\n");
+}
+
+int main(int argc, char **argv)
+{
+    int quick = 0;
+    double max_disks = 1e7;
+    const char *dir = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--quick") == 0)
+            quick = 1;
+        else if (strcmp(argv[i], "--max-disks") == 0 && i + 1 < argc)
+            max_disks = atof(argv[++i]);
+        else
+            dir = argv[i];
+    }
+    if (!dir) {
+        fprintf(stderr, "usage: grainpack_bench [--quick] [--max-disks N] EXAMPLES_DIR\n");
+        return 2;
+    }
+    print_machine();
+    bench_cases(dir, quick ? 3 : 15, quick ? 5 : 50);
+    bench_scaling(quick ? 1e5 : max_disks);
+    return 0;
+}

@@ -1,0 +1,23 @@
+/* domain.c - the rectangle [0,W] x [0,H]. */
+#include "grainpack/domain.h"
+
+void gp_domain_corner(const gp_domain *domain, int i, double *x, double *y)
+{
+    switch (i & 3) {
+    case 0: *x = 0.0; *y = 0.0; break;
+    case 1: *x = domain->width; *y = 0.0; break;
+    case 2: *x = domain->width; *y = domain->height; break;
+    default: *x = 0.0; *y = domain->height; break;
+    }
+}
+
+double gp_domain_area(const gp_domain *domain)
+{
+    return domain->width * domain->height;
+}
+
+int gp_domain_contains_disk(const gp_domain *domain, double x, double y, double R, double slack)
+{
+    return x - R >= -slack && y - R >= -slack && x + R <= domain->width + slack &&
+           y + R <= domain->height + slack;
+}

@@ -1,0 +1,126 @@
+/* front.h - the advancing front (internal to core/).
+ *
+ * The front is a set of closed loops of disk centres, counter-clockwise around the part
+ * of the domain still empty: each loop is a circular doubly linked list of nodes, and the
+ * segment u -> u.next of node u has the filled region on its right. A disk can sit on
+ * several loops (where a loop was pinched in two), once per node.
+ *
+ * Segments waiting to be worked sit in one bucket per level (SPEC §3.3). The segment to
+ * try first in a level is its newest untried one, else the one that failed for the
+ * largest radius; so "the first segment of a level that has not failed for a radius <= R"
+ * is read in O(1), and updated in O(1) (untried) or O(log n) (failed).
+ *
+ * A segment whose disks do not touch spans a void. Such a "barrier" is registered in the
+ * bucket grid so that no later disk is placed across it into the filled side; with it,
+ * the loops stay simple and every closing cuts a triangle off the empty region. */
+#ifndef GRAINPACK_CORE_FRONT_H
+#define GRAINPACK_CORE_FRONT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/disk.h"
+#include "grainpack/grid.h"
+
+#define FRONT_NONE (-1)
+
+typedef struct front_node {
+    int32_t disk;
+    int32_t prev, next;     /* neighbours on the loop; next is the free list when unused */
+    int32_t next_of_disk;   /* another node of the same disk */
+    uint32_t loop;          /* loop label: equal labels, same loop */
+    /* the segment disk -> next's disk */
+    double ux, uy, length;  /* unit vector a -> b and distance of the centres */
+    uint32_t level;         /* level(a) + level(b) (report eq. 5) */
+    uint8_t state;          /* SEG_UNTRIED, SEG_FAILED or SEG_FROZEN */
+    double fail_R;          /* smallest packing radius that failed here; +inf if untried */
+    int32_t list_prev, list_next; /* SEG_UNTRIED: neighbours in the level's untried list */
+    uint32_t heap_pos;      /* SEG_FAILED: position in the level's heap of failed segments */
+    int32_t blocker;        /* SEG_FAILED: the disk last in the way, tested first next time */
+    int32_t next_barrier;   /* next barrier registered in the same grid cell */
+    int32_t barrier_cell;   /* grid cell of the registration, FRONT_NONE if the disks touch */
+    double gap[4];          /* the uncovered part of a barrier: px, py, qx, qy */
+} front_node;
+
+enum { SEG_UNTRIED = 0, SEG_FAILED, SEG_FROZEN };
+
+/* The segments of one level still to work: the untried ones in a list, newest first (the
+ * front sweeps on from the last placement, as the report's in-place list does), and the
+ * ones that failed in a max-heap on the radius they failed for. */
+typedef struct front_failed {
+    double fail_R;          /* copied from the node, so that sifting reads the heap only */
+    int32_t node;
+} front_failed;
+
+typedef struct front_bucket {
+    int32_t untried;        /* newest untried segment, FRONT_NONE if none */
+    front_failed *failed;   /* 4-ary max-heap on fail_R */
+    uint32_t nfailed, capacity;
+} front_bucket;
+
+/* The front borrows the disks, levels and grid of its packer (they must outlive it) and
+ * owns everything else. */
+typedef struct front {
+    const gp_disk *const *disks;  /* the packer's disk array (it moves when it grows) */
+    const uint32_t *const *levels;
+    const gp_grid *grid;
+
+    front_node *nodes;
+    size_t nnodes, node_capacity;
+    int32_t free_node;
+    uint32_t next_loop;
+    front_bucket *buckets;
+    uint32_t nbuckets, low;       /* no bucket below `low` holds a segment */
+    size_t active;                /* segments in the buckets, still to be worked */
+    size_t frozen;                /* segments given up on */
+
+    int32_t *first_node;          /* per disk: one of its nodes, FRONT_NONE if off the front */
+    size_t disk_capacity;
+    int32_t *barrier_head;        /* per grid cell */
+} front;
+
+/* Sets up an empty front over `grid`, with per-disk room for `disk_capacity` disks.
+ * Returns 0 or GP_ENOMEM (front_free is safe either way). */
+int front_init(front *f, const gp_disk *const *disks, const uint32_t *const *levels,
+               const gp_grid *grid, size_t disk_capacity);
+void front_free(front *f);
+
+/* Makes per-disk room for `capacity` disks; returns 0 or GP_ENOMEM. */
+int front_reserve_disks(front *f, size_t capacity);
+
+/* Registers a new disk (off the front). */
+void front_disk_added(front *f, int32_t disk);
+
+/* Makes a loop of the n >= 3 disks given counter-clockwise; returns 0 or GP_ENOMEM. */
+int front_add_loop(front *f, const int32_t *disks, size_t n);
+
+/* The lowest level holding a segment to work (meaningful while f->active > 0). */
+uint32_t front_low_level(front *f);
+
+/* The node whose segment to try first at `level`, or FRONT_NONE. */
+int32_t front_top(const front *f, uint32_t level);
+
+/* Records that node u's segment failed for packing radius R (it keeps the smallest). */
+void front_mark_failed(front *f, int32_t u, double R);
+
+/* Disk c was placed against node u's segment (a, b): the segment becomes a -> c -> b.
+ * Returns 0 or GP_ENOMEM. */
+int front_place(front *f, int32_t u, int32_t c);
+
+/* The node of `disk` on the same loop as node u, or FRONT_NONE. */
+int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u);
+
+/* Closes the front at node u's segment (p1, p2) on node w of the same loop (SPEC §3.5):
+ * the segment is replaced by p1 -> pk -> p2, which cuts an ear off the loop when pk is
+ * next to p1 or p2, and splits the loop in two otherwise. Loops left with fewer than
+ * three nodes enclose nothing and go. Returns 0 or GP_ENOMEM. */
+int front_close(front *f, int32_t u, int32_t w);
+
+/* Takes node u's segment out of the work; it still bounds its loop. */
+void front_freeze(front *f, int32_t u);
+
+/* A barrier (other than node `skip`'s segment) that the disk (x, y, R) would cross, as
+ * the node whose segment it is, or FRONT_NONE. */
+int32_t front_barrier_crossed(const front *f, double x, double y, double R, int32_t skip);
+
+#endif

@@ -1,0 +1,136 @@
+/* grid.c - bucket grid for neighbour queries (SPEC §3.4). */
+#include "grainpack/grid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grainpack/error.h"
+
+int gp_grid_init(gp_grid *grid, const gp_domain *domain, double R_max, size_t capacity,
+                 size_t max_cells)
+{
+    memset(grid, 0, sizeof *grid);
+    grid->domain = domain;
+    grid->cell = 2.0 * R_max;
+    grid->inv_cell = 1.0 / grid->cell;
+    /* m = E(W / 2R_max) + 1, n = E(H / 2R_max) + 1 (report eqs. 3-4) */
+    double nx = floor(domain->width * grid->inv_cell) + 1.0;
+    double ny = floor(domain->height * grid->inv_cell) + 1.0;
+    if (!(nx * ny <= (double)max_cells) || nx > INT32_MAX || ny > INT32_MAX)
+        return GP_ETOOBIG;
+    grid->nx = (int32_t)nx;
+    grid->ny = (int32_t)ny;
+    size_t cells = (size_t)grid->nx * (size_t)grid->ny;
+    grid->head = malloc(cells * sizeof *grid->head);
+    if (!grid->head)
+        return GP_ENOMEM;
+    memset(grid->head, 0xff, cells * sizeof *grid->head); /* all GP_GRID_NONE */
+    int rc = gp_grid_reserve(grid, capacity);
+    if (rc)
+        gp_grid_free(grid);
+    return rc;
+}
+
+void gp_grid_free(gp_grid *grid)
+{
+    free(grid->head);
+    free(grid->next);
+    memset(grid, 0, sizeof *grid);
+}
+
+int gp_grid_reserve(gp_grid *grid, size_t capacity)
+{
+    if (capacity <= grid->capacity)
+        return 0;
+    int32_t *next = realloc(grid->next, capacity * sizeof *next);
+    if (!next)
+        return GP_ENOMEM;
+    grid->next = next;
+    grid->capacity = capacity;
+    return 0;
+}
+
+static int32_t clamp_cell(double v, int32_t n)
+{
+    if (!(v >= 0.0))
+        return 0;
+    if (v >= (double)n)
+        return n - 1;
+    return (int32_t)v;
+}
+
+size_t gp_grid_cell(const gp_grid *grid, double x, double y)
+{
+    int32_t ix = clamp_cell(x * grid->inv_cell, grid->nx);
+    int32_t iy = clamp_cell(y * grid->inv_cell, grid->ny);
+    return (size_t)iy * (size_t)grid->nx + (size_t)ix;
+}
+
+void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y)
+{
+    size_t c = gp_grid_cell(grid, x, y);
+    grid->next[id] = grid->head[c];
+    grid->head[c] = id;
+}
+
+void gp_grid_remove(gp_grid *grid, int32_t id, double x, double y)
+{
+    int32_t *link = &grid->head[gp_grid_cell(grid, x, y)];
+    while (*link != GP_GRID_NONE && *link != id)
+        link = &grid->next[*link];
+    if (*link == id)
+        *link = grid->next[id];
+}
+
+/* The report's search order around cell (i, j): itself, (i+1,j), (i,j+1), (i-1,j),
+ * (i,j-1), then the corners (i+1,j+1), (i-1,j+1), (i-1,j-1), (i+1,j-1). */
+const int8_t gp_grid_search_order[9][2] = {{0, 0}, {1, 0},  {0, 1},   {-1, 0}, {0, -1},
+                                           {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+
+/* Visits the 3x3 cells around (x, y); for each disk overlapping (x, y, R) other than the
+ * skipped two, stores it (if room) and stops after the first when `first_only`. */
+static size_t scan_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                            double R, int32_t skip_a, int32_t skip_b, int first_only,
+                            int32_t *out, size_t cap)
+{
+    int32_t ix = clamp_cell(x * grid->inv_cell, grid->nx);
+    int32_t iy = clamp_cell(y * grid->inv_cell, grid->ny);
+    size_t found = 0;
+    for (int k = 0; k < 9; k++) {
+        int32_t cx = ix + gp_grid_search_order[k][0], cy = iy + gp_grid_search_order[k][1];
+        if (cx < 0 || cy < 0 || cx >= grid->nx || cy >= grid->ny)
+            continue;
+        for (int32_t id = grid->head[(size_t)cy * (size_t)grid->nx + (size_t)cx];
+             id != GP_GRID_NONE; id = grid->next[id]) {
+            if (id == skip_a || id == skip_b)
+                continue;
+            const gp_disk *d = &disks[id];
+            double dx = d->x - x, dy = d->y - y;
+            double reach = (d->R + R) * (1.0 - GP_CONTACT_RTOL);
+            if (dx * dx + dy * dy >= reach * reach)
+                continue;
+            if (found < cap)
+                out[found] = id;
+            found++;
+            if (first_only)
+                return found;
+        }
+    }
+    return found;
+}
+
+int32_t gp_grid_first_overlap(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                              double R, int32_t skip_a, int32_t skip_b)
+{
+    int32_t id = GP_GRID_NONE;
+    scan_overlaps(grid, disks, x, y, R, skip_a, skip_b, 1, &id, 1);
+    return id;
+}
+
+size_t gp_grid_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                        double R, int32_t skip_a, int32_t skip_b, int32_t *out, size_t cap)
+{
+    return scan_overlaps(grid, disks, x, y, R, skip_a, skip_b, 0, out, cap);
+}
+

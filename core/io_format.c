@@ -1,0 +1,43 @@
+/* io_format.c - result format names, media types and dispatch. */
+#include <string.h>
+
+#include "grainpack/io.h"
+
+static const struct {
+    const char *name, *media_type;
+} formats[] = {
+    [GP_FORMAT_JSON] = {"json", "application/json"},
+    [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8"},
+    [GP_FORMAT_SVG] = {"svg", "image/svg+xml"},
+};
+
+int gp_format_parse(const char *name, gp_format *out)
+{
+    for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++) {
+        if (strcmp(name, formats[i].name) == 0) {
+            *out = (gp_format)i;
+            return 0;
+        }
+    }
+    return GP_EINVAL;
+}
+
+const char *gp_format_name(gp_format format)
+{
+    return formats[format].name;
+}
+
+const char *gp_format_media_type(gp_format format)
+{
+    return formats[format].media_type;
+}
+
+int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result)
+{
+    switch (format) {
+    case GP_FORMAT_JSON: return gp_write_json(out, spec, result);
+    case GP_FORMAT_CSV: return gp_write_csv(out, result);
+    case GP_FORMAT_SVG: return gp_write_svg(out, spec, result);
+    }
+    return GP_EINVAL;
+}

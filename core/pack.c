@@ -1,0 +1,537 @@
+/* pack.c - the advancing-front disk packer of SPEC §3 (report §III, Algorithm 1).
+ *
+ * Disks are laid along the boundary (the initial front), then placed one at a time
+ * tangent to the two disks of a front segment, lowest level first, with the radius drawn
+ * from the law kept until it is placed. When no segment of the front's level band takes
+ * the radius, the front is closed at its first segment by the distance criterion.
+ * The loops of segments themselves are kept by front.c. */
+#include "grainpack/pack.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "front.h"
+#include "grainpack/grid.h"
+
+/* Fraction of the domain a packing is expected to fill: used for the capacity guess and
+ * to turn the filled area into a progress fraction. */
+#define FILL_GUESS 0.86
+/* Tries between two progress reports / cancel checks: well under a millisecond. */
+#define PROGRESS_EVERY 2048
+/* Closings a disk may start (as p1) before the segments it starts are frozen instead.
+ * A disk of radius R_max ringed by disks of radius R_min has about pi (R_max + R_min) /
+ * R_min neighbours, each of which may cost one closing: 64 covers a ratio of 20. With
+ * simple loops the cap is never reached (it was not, over 160 runs of the reference
+ * cases); it is there so that the loop stays finite whatever rounding does. */
+#define CLOSINGS_PER_DISK 64
+
+typedef struct packer {
+    const gp_pack_params *params;
+    const gp_progress *progress;
+    gp_rng rng;
+    double pending_r, pending_R; /* the drawn radius, kept until it is placed */
+
+    gp_disk *disks;
+    uint32_t *level;    /* per disk (report eq. 6) */
+    uint8_t *closings;  /* per disk: closings it started as p1 */
+    size_t count, capacity;
+    gp_grid grid;
+    front fr;
+
+    int32_t *conflicts; /* scratch for the closing step, room for two at least */
+    size_t conflict_capacity;
+
+    gp_packing *out;
+    gp_error *err;
+    uint64_t work_since_report;
+} packer;
+
+/* ---- radii ---- */
+
+static void draw_radius(packer *pk)
+{
+    pk->pending_r = gp_distribution_sample(pk->params->dist, &pk->rng);
+    pk->pending_R = gp_joint_packing_radius(pk->params->joint, pk->pending_r);
+}
+
+/* ---- disks ---- */
+
+static int grow_disks(packer *pk)
+{
+    size_t cap = pk->capacity + pk->capacity / 2 + 64;
+    gp_disk *disks = realloc(pk->disks, cap * sizeof *disks);
+    if (!disks)
+        return GP_ENOMEM;
+    pk->disks = disks;
+    uint32_t *level = realloc(pk->level, cap * sizeof *level);
+    if (!level)
+        return GP_ENOMEM;
+    pk->level = level;
+    uint8_t *closings = realloc(pk->closings, cap * sizeof *closings);
+    if (!closings)
+        return GP_ENOMEM;
+    pk->closings = closings;
+    if (gp_grid_reserve(&pk->grid, cap) || front_reserve_disks(&pk->fr, cap))
+        return GP_ENOMEM;
+    pk->capacity = cap;
+    return 0;
+}
+
+/* Appends the pending radius as a disk at (x, y) with the given level and draws the next
+ * radius. Returns its id, or a negative GP_E code. */
+static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
+{
+    if (pk->params->max_disks && pk->count >= pk->params->max_disks)
+        return gp_error_set(pk->err, GP_ETOOBIG, NULL,
+                            "the packing exceeded the cap of %zu disks", pk->params->max_disks);
+    if (pk->count == pk->capacity && grow_disks(pk))
+        return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory after %zu disks", pk->count);
+    int32_t id = (int32_t)pk->count++;
+    pk->disks[id] = (gp_disk){x, y, pk->pending_r, pk->pending_R};
+    pk->level[id] = level;
+    pk->closings[id] = 0;
+    gp_grid_insert(&pk->grid, id, x, y);
+    front_disk_added(&pk->fr, id);
+    pk->out->fill_area += M_PI * pk->pending_R * pk->pending_R;
+    if (level > pk->out->max_level)
+        pk->out->max_level = level;
+    draw_radius(pk);
+    return id;
+}
+
+/* Whether a packing disk of radius R centred at (x, y) fits: inside the domain,
+ * overlapping no disk but the two it was placed against, and crossing no barrier of the
+ * front but the segment it was placed against. */
+static int fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
+                int32_t skip_segment)
+{
+    return gp_domain_contains_disk(pk->params->domain, x, y, R, R * GP_CONTACT_RTOL) &&
+           gp_grid_first_overlap(&pk->grid, pk->disks, x, y, R, skip_a, skip_b) == GP_GRID_NONE &&
+           front_barrier_crossed(&pk->fr, x, y, R, skip_segment) == FRONT_NONE;
+}
+
+/* Whether the disk (x, y, R) overlaps disk `id` (cheap test run before the grid's). */
+static int overlaps_disk(const packer *pk, double x, double y, double R, int32_t id)
+{
+    gp_disk candidate = {x, y, R, R};
+    return gp_disks_overlap(&candidate, &pk->disks[id]);
+}
+
+static int front_oom(packer *pk)
+{
+    return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the front");
+}
+
+/* ---- the initial front (SPEC §3.2) ---- */
+
+static int build_initial_front(packer *pk)
+{
+    const gp_domain *dom = pk->params->domain;
+    enum { N = GP_DOMAIN_CORNERS };
+    double vx[N], vy[N], ex[N], ey[N], nx[N], ny[N];
+    for (int i = 0; i < N; i++)
+        gp_domain_corner(dom, i, &vx[i], &vy[i]);
+    for (int i = 0; i < N; i++) {
+        double dx = vx[(i + 1) % N] - vx[i], dy = vy[(i + 1) % N] - vy[i];
+        double len = sqrt(dx * dx + dy * dy);
+        ex[i] = dx / len;
+        ey[i] = dy / len;
+        nx[i] = -ey[i]; /* inward: the domain is counter-clockwise */
+        ny[i] = ex[i];
+    }
+
+    /* One disk in each corner first, so that every edge knows where it must stop. The
+     * centre at distance R from both edges is v + R (n_prev + n) / (1 + n_prev . n). */
+    int32_t corner_disk[N];
+    for (int i = 0; i < N; i++) {
+        int p = (i + N - 1) % N;
+        double scale = pk->pending_R / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
+        double cx = vx[i] + scale * (nx[p] + nx[i]), cy = vy[i] + scale * (ny[p] + ny[i]);
+        corner_disk[i] = -1;
+        if (fits(pk, cx, cy, pk->pending_R, -1, -1, FRONT_NONE)) {
+            int32_t id = add_disk(pk, cx, cy, 0);
+            if (id < 0)
+                return id;
+            corner_disk[i] = id;
+        }
+    }
+
+    /* Then along each edge, counter-clockwise: each disk touches the wall and the disks
+     * before it on the edge (two disks touching a wall with radii R, R' have centres
+     * 2 sqrt(R R') apart along it; the new one goes as near the corner as that allows,
+     * which is tangent to the previous disk unless a tiny one sits between two large
+     * ones), until the next one would hit the next corner's disk or leave the domain. */
+    size_t loop_len = 0, loop_cap = 256;
+    int32_t *loop = malloc(loop_cap * sizeof *loop);
+    if (!loop)
+        return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
+    int rc = 0;
+    for (int i = 0; i < N && rc == 0; i++) {
+        if (corner_disk[i] < 0)
+            continue;
+        size_t edge_start = loop_len;
+        int32_t prev = corner_disk[i];
+        int p = (i + N - 1) % N;
+        /* a disk larger than the corner's must clear the previous wall too: at the least
+         * it sits where the corner disk would for its own radius */
+        double clear = (nx[p] * ex[i] + ny[p] * ey[i]) / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
+        for (;;) {
+            if (loop_len == loop_cap) {
+                int32_t *grown = realloc(loop, 2 * loop_cap * sizeof *loop);
+                if (!grown) {
+                    rc = gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
+                    break;
+                }
+                loop = grown;
+                loop_cap *= 2;
+            }
+            loop[loop_len++] = prev;
+            double R = pk->pending_R, t = clear * R;
+            double t_prev = (pk->disks[prev].x - vx[i]) * ex[i] + (pk->disks[prev].y - vy[i]) * ey[i];
+            /* only disks within 2 R_max of the last one along the edge can be in the way */
+            for (size_t k = loop_len; k-- > edge_start;) {
+                const gp_disk *dk = &pk->disks[loop[k]];
+                double tk = (dk->x - vx[i]) * ex[i] + (dk->y - vy[i]) * ey[i];
+                if (tk < t_prev - 2.0 * pk->grid.cell)
+                    break;
+                double reach = tk + 2.0 * sqrt(R * dk->R);
+                if (reach > t)
+                    t = reach;
+            }
+            double cx = vx[i] + t * ex[i] + R * nx[i], cy = vy[i] + t * ey[i] + R * ny[i];
+            if (!fits(pk, cx, cy, R, -1, -1, FRONT_NONE))
+                break;
+            int32_t id = add_disk(pk, cx, cy, 0);
+            if (id < 0) {
+                rc = id;
+                break;
+            }
+            prev = id;
+        }
+    }
+    pk->out->initial_front = pk->count;
+    /* fewer than three disks enclose nothing: the domain holds no more */
+    if (rc == 0 && loop_len >= 3 && front_add_loop(&pk->fr, loop, loop_len))
+        rc = front_oom(pk);
+    free(loop);
+    return rc;
+}
+
+/* ---- the loop (SPEC §3.5) ---- */
+
+/* The disks of node u's segment. */
+static int32_t seg_from(const packer *pk, int32_t u)
+{
+    return pk->fr.nodes[u].disk;
+}
+
+static int32_t seg_to(const packer *pk, int32_t u)
+{
+    return pk->fr.nodes[pk->fr.nodes[u].next].disk;
+}
+
+/* Where a disk of radius R goes against node u's segment (a, b): tangent to both on the
+ * empty side (SPEC §3.1, as gp_place_tangent); or, when the two are further apart than the
+ * disk can bridge and `bridge_gap` is set, touching a with its centre on the segment, so
+ * that the gap is filled from one end rather than given up. Returns 1 with the centre when the position
+ * exists and fits. The disk that was in the way last time, then the disks next to a and b
+ * on the loop, are the likeliest to be in the way, so they are tested before the grid;
+ * a disk found in the way is remembered in the node. */
+static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double *x, double *y)
+{
+    front_node *nodes = pk->fr.nodes;
+    const front_node *n = &nodes[u];
+    int32_t a = n->disk, b = nodes[n->next].disk;
+    const gp_disk *da = &pk->disks[a], *db = &pk->disks[b];
+    /* SPEC §3.1 with the segment's direction and length computed once per segment */
+    double ra = da->R + R, rb = db->R + R, d = n->length;
+    if (d > ra + rb) {
+        if (!bridge_gap)
+            return 0;
+        *x = da->x + ra * n->ux;
+        *y = da->y + ra * n->uy;
+    } else {
+        if (!(d > 0.0) || d < fabs(ra - rb))
+            return 0;
+        double along = (ra * ra - rb * rb + d * d) / (2.0 * d);
+        double h2 = ra * ra - along * along;
+        double h = h2 > 0.0 ? sqrt(h2) : 0.0;
+        *x = da->x + along * n->ux - h * n->uy;
+        *y = da->y + along * n->uy + h * n->ux;
+    }
+    int32_t likely[3] = {nodes[u].blocker, nodes[nodes[u].prev].disk,
+                         nodes[nodes[nodes[u].next].next].disk};
+    for (int i = 0; i < 3; i++)
+        if (likely[i] >= 0 && likely[i] != a && likely[i] != b &&
+            overlaps_disk(pk, *x, *y, R, likely[i])) {
+            nodes[u].blocker = likely[i];
+            return 0;
+        }
+    if (!gp_domain_contains_disk(pk->params->domain, *x, *y, R, R * GP_CONTACT_RTOL))
+        return 0;
+    int32_t q = gp_grid_first_overlap(&pk->grid, pk->disks, *x, *y, R, a, b);
+    if (q != GP_GRID_NONE) {
+        nodes[u].blocker = q;
+        return 0;
+    }
+    return front_barrier_crossed(&pk->fr, *x, *y, R, u) == FRONT_NONE;
+}
+
+/* Whether node u's segment is wider than a disk of radius R can bridge. */
+static int too_wide(const packer *pk, int32_t u, double R)
+{
+    const gp_disk *da = &pk->disks[seg_from(pk, u)], *db = &pk->disks[seg_to(pk, u)];
+    return pk->fr.nodes[u].length > da->R + db->R + 2.0 * R;
+}
+
+/* Places the pending radius against node u's segment (see find_position) if it fits
+ * there. Returns 1 if placed, 0 if not, or a GP_E code. */
+static int try_segment(packer *pk, int32_t u, int bridge_gap)
+{
+    int32_t a = seg_from(pk, u), b = seg_to(pk, u);
+    double x, y;
+    pk->out->attempts++;
+    pk->work_since_report++;
+    if (!find_position(pk, u, pk->pending_R, bridge_gap, &x, &y))
+        return 0;
+    uint32_t la = pk->level[a], lb = pk->level[b];
+    /* our definition of report eq. 6: one more than the lower of the two */
+    int32_t c = add_disk(pk, x, y, (la < lb ? la : lb) + 1);
+    if (c < 0)
+        return c;
+    return front_place(&pk->fr, u, c) ? front_oom(pk) : 1;
+}
+
+/* The criterion of our eq. 7: the free space between pi and the two disks of s. */
+static double closing_gap(const gp_disk *d1, const gp_disk *d2, const gp_disk *di)
+{
+    return hypot(di->x - d1->x, di->y - d1->y) - d1->R - di->R +
+           hypot(di->x - d2->x, di->y - d2->y) - d2->R - di->R;
+}
+
+/* Collects in pk->conflicts the disks the pending radius meets at (x, y) when placed
+ * against node u's segment: the disks it overlaps, and the two ends of a barrier it would
+ * cross. Returns how many, or GP_ENOMEM. */
+static long gather_conflicts(packer *pk, double x, double y, int32_t u)
+{
+    size_t n;
+    for (;;) {
+        n = gp_grid_overlaps(&pk->grid, pk->disks, x, y, pk->pending_R, seg_from(pk, u),
+                             seg_to(pk, u), pk->conflicts, pk->conflict_capacity);
+        if (n + 2 <= pk->conflict_capacity)
+            break;
+        size_t cap = n + 16;
+        int32_t *grown = realloc(pk->conflicts, cap * sizeof *grown);
+        if (!grown)
+            return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory closing the front");
+        pk->conflicts = grown;
+        pk->conflict_capacity = cap;
+    }
+    int32_t barrier = front_barrier_crossed(&pk->fr, x, y, pk->pending_R, u);
+    if (barrier != FRONT_NONE) {
+        pk->conflicts[n++] = seg_from(pk, barrier);
+        pk->conflicts[n++] = seg_to(pk, barrier);
+    }
+    return (long)n;
+}
+
+/* Among the n disks in pk->conflicts, the node the front closes on at node u's segment
+ * (p1, p2), or FRONT_NONE: a disk of the same loop, strictly on the empty side of p1 -> p2,
+ * with the least closing_gap. A disk off the loop is buried or beyond another loop, and
+ * one behind the segment is on the filled side: joining either would wind the front back
+ * over filled ground, whereas a disk on the empty side makes the closing cut a triangle
+ * off the empty region, which is what lets the front shrink to nothing. */
+static int32_t closing_node(const packer *pk, size_t n, int32_t u)
+{
+    int32_t p1 = seg_from(pk, u), p2 = seg_to(pk, u);
+    const gp_disk *d1 = &pk->disks[p1], *d2 = &pk->disks[p2];
+    double best_gap = INFINITY;
+    int32_t best = FRONT_NONE;
+    for (size_t i = 0; i < n; i++) {
+        int32_t id = pk->conflicts[i];
+        const gp_disk *di = &pk->disks[id];
+        if (id == p1 || id == p2 || gp_orient2d(d1->x, d1->y, d2->x, d2->y, di->x, di->y) <= 0.0)
+            continue;
+        int32_t w = front_node_on_loop(&pk->fr, id, u);
+        if (w == FRONT_NONE)
+            continue;
+        double gap = closing_gap(d1, d2, di);
+        if (gap < best_gap) {
+            best_gap = gap;
+            best = w;
+        }
+    }
+    return best;
+}
+
+/* Nothing in the front's level band takes the pending radius: close the front at node u's
+ * segment (p1, p2) (SPEC §3.5, our eq. 7), on the node chosen by closing_node among the
+ * disks the radius met when placed against it. When it met none of the loop (only the
+ * wall, or disks the front has passed) or the two disks are too far apart for it, the
+ * segment is frozen and the pocket behind it stays a void. */
+static int close_front(packer *pk, int32_t u)
+{
+    int32_t p1 = seg_from(pk, u), p2 = seg_to(pk, u);
+    double x, y;
+    int32_t w = FRONT_NONE;
+    pk->out->closures++;
+    if (pk->closings[p1] >= CLOSINGS_PER_DISK) {
+        front_freeze(&pk->fr, u);
+        pk->out->capped++;
+        return 0;
+    }
+    pk->closings[p1]++;
+    if (gp_place_tangent(&pk->disks[p1], &pk->disks[p2], pk->pending_R, &x, &y)) {
+        long n = gather_conflicts(pk, x, y, u);
+        if (n < 0)
+            return (int)n;
+        w = closing_node(pk, (size_t)n, u);
+    }
+    if (w == FRONT_NONE) {
+        front_freeze(&pk->fr, u);
+        pk->out->frozen++;
+        return 0;
+    }
+    return front_close(&pk->fr, u, w) ? front_oom(pk) : 0;
+}
+
+static int report_progress(packer *pk)
+{
+    pk->work_since_report = 0;
+    const gp_progress *pr = pk->progress;
+    if (!pr)
+        return 0;
+    if (pr->cancel && atomic_load_explicit(pr->cancel, memory_order_relaxed))
+        return gp_error_set(pk->err, GP_ECANCELED, NULL, "packing canceled after %zu disks", pk->count);
+    if (pr->report) {
+        double expected = FILL_GUESS * gp_domain_area(pk->params->domain);
+        double f = pk->out->fill_area / expected;
+        pr->report(pr->ctx, "pack", f < 0.99 ? f : 0.99);
+    }
+    return 0;
+}
+
+static int run_front(packer *pk)
+{
+    uint32_t band = pk->params->level_band;
+    while (pk->fr.active > 0) {
+        if (pk->work_since_report >= PROGRESS_EVERY) {
+            int rc = report_progress(pk);
+            if (rc)
+                return rc;
+        }
+        /* the first segment of the front's level is tried first, whatever it failed for
+         * before; then every segment of the level band that has not failed for a radius
+         * <= R, lowest level first; and only then is the front closed at the first */
+        uint32_t low = front_low_level(&pk->fr);
+        int32_t first = front_top(&pk->fr, low);
+        int placed = try_segment(pk, first, 0);
+        if (placed < 0)
+            return placed;
+        if (!placed)
+            front_mark_failed(&pk->fr, first, pk->pending_R);
+        for (uint32_t level = low; level <= low + band && !placed; level++) {
+            int32_t s;
+            while (!placed && (s = front_top(&pk->fr, level)) != FRONT_NONE &&
+                   pk->fr.nodes[s].fail_R > pk->pending_R) {
+                placed = try_segment(pk, s, 0);
+                if (placed < 0)
+                    return placed;
+                if (!placed)
+                    front_mark_failed(&pk->fr, s, pk->pending_R);
+            }
+        }
+        if (!placed && too_wide(pk, first, pk->pending_R)) {
+            /* a gap wider than the radius is filled from one end before it is given up */
+            placed = try_segment(pk, first, 1);
+            if (placed < 0)
+                return placed;
+        }
+        if (!placed) {
+            int rc = close_front(pk, first);
+            if (rc)
+                return rc;
+        }
+    }
+    return 0;
+}
+
+int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
+            gp_error *err)
+{
+    memset(out, 0, sizeof *out);
+    packer pk;
+    memset(&pk, 0, sizeof pk);
+    pk.params = params;
+    pk.progress = progress;
+    pk.out = out;
+    pk.err = err;
+    gp_rng_seed(&pk.rng, params->seed);
+
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(params->dist, &r_min, &r_max);
+    gp_joint_packing_range(params->joint, r_min, r_max, &R_min, &R_max);
+    if (!(R_max > 0.0) || !(params->domain->width >= 2 * R_max) ||
+        !(params->domain->height >= 2 * R_max))
+        return gp_error_set(err, GP_EINVAL, NULL,
+                            "the largest packing disk (R = %g) does not fit in the domain", R_max);
+
+    /* room for the expected number of disks, so that large runs never copy the arrays */
+    double expected = FILL_GUESS * gp_domain_area(params->domain) /
+                      (M_PI * gp_distribution_mean_packing_r2(params->dist, params->joint));
+    size_t capacity = (size_t)(expected * 1.04) + 256;
+    if (params->max_disks && capacity > params->max_disks + 1)
+        capacity = params->max_disks + 1;
+
+    /* the grid has about one cell per expected disk or fewer (cells are 2 R_max wide) */
+    int rc = gp_grid_init(&pk.grid, params->domain, R_max, capacity, (size_t)(4.0 * expected) + 1024);
+    if (rc == GP_ETOOBIG)
+        gp_error_set(err, rc, NULL, "the bucket grid would be too large for this domain");
+    else if (rc)
+        gp_error_set(err, rc, NULL, "out of memory for the bucket grid");
+    if (rc == 0) {
+        pk.disks = malloc(capacity * sizeof *pk.disks);
+        pk.level = malloc(capacity * sizeof *pk.level);
+        pk.closings = malloc(capacity * sizeof *pk.closings);
+        pk.capacity = capacity;
+        pk.conflict_capacity = 64;
+        pk.conflicts = malloc(pk.conflict_capacity * sizeof *pk.conflicts);
+        if (!pk.conflicts || !pk.disks || !pk.level || !pk.closings ||
+            front_init(&pk.fr, (const gp_disk *const *)&pk.disks, (const uint32_t *const *)&pk.level,
+                       &pk.grid, capacity))
+            rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for %zu disks", capacity);
+    }
+    if (rc == 0) {
+        draw_radius(&pk);
+        rc = build_initial_front(&pk);
+    }
+    if (rc == 0)
+        rc = run_front(&pk);
+
+    free(pk.level);
+    free(pk.closings);
+    free(pk.conflicts);
+    front_free(&pk.fr);
+    gp_grid_free(&pk.grid);
+    if (rc) {
+        free(pk.disks);
+        memset(out, 0, sizeof *out);
+        return rc;
+    }
+    /* hand back exactly what is used */
+    gp_disk *trimmed = pk.count ? realloc(pk.disks, pk.count * sizeof *trimmed) : NULL;
+    if (!pk.count)
+        free(pk.disks);
+    out->disks = trimmed ? trimmed : (pk.count ? pk.disks : NULL);
+    out->count = pk.count;
+    if (progress && progress->report)
+        progress->report(progress->ctx, "pack", 1.0);
+    return 0;
+}
+
+void gp_packing_free(gp_packing *packing)
+{
+    free(packing->disks);
+    memset(packing, 0, sizeof *packing);
+}

@@ -1,0 +1,484 @@
+/* spec.c - parsing and validating the job spec (jansson). Every message names the field
+ * by its JSON pointer in the submitted document and says what was expected. */
+#include "grainpack/spec.h"
+
+#include <errno.h>
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Packing density assumed by the disk-count estimate: a little above what the front
+ * reaches (0.80-0.88), so that the estimate errs on the high side. */
+#define EXPECTED_FILL 0.90
+
+typedef struct validator {
+    gp_error *err;
+    size_t max_disks, max_bins;
+} validator;
+
+/* Appends "/" + key (escaped per RFC 6901) to base. */
+static void pointer_key(char *out, const char *base, const char *key)
+{
+    size_t n = (size_t)snprintf(out, GP_ERROR_POINTER_MAX, "%s/", base);
+    for (const char *k = key; *k && n + 3 < GP_ERROR_POINTER_MAX; k++) {
+        if (*k == '~') {
+            out[n++] = '~';
+            out[n++] = '0';
+        } else if (*k == '/') {
+            out[n++] = '~';
+            out[n++] = '1';
+        } else {
+            out[n++] = *k;
+        }
+    }
+    out[n < GP_ERROR_POINTER_MAX ? n : GP_ERROR_POINTER_MAX - 1] = '\0';
+}
+
+static void pointer_index(char *out, const char *base, size_t index)
+{
+    char key[24];
+    snprintf(key, sizeof key, "%zu", index);
+    pointer_key(out, base, key);
+}
+
+static const char *type_phrase(const json_t *v)
+{
+    switch (json_typeof(v)) {
+    case JSON_OBJECT: return "an object";
+    case JSON_ARRAY: return "an array";
+    case JSON_STRING: return "a string";
+    case JSON_INTEGER: return "an integer";
+    case JSON_REAL: return "a number";
+    case JSON_TRUE: return "true";
+    case JSON_FALSE: return "false";
+    case JSON_NULL: return "null";
+    }
+    return "a value";
+}
+
+/* Rejects members of obj not in the NULL-terminated list `allowed`. */
+static int check_members(validator *v, const json_t *obj, const char *base,
+                         const char *const *allowed, const char *expected_list)
+{
+    const char *key;
+    json_t *value;
+    json_object_foreach((json_t *)obj, key, value) {
+        int known = 0;
+        for (const char *const *a = allowed; *a; a++)
+            known |= strcmp(*a, key) == 0;
+        if (!known) {
+            char ptr[GP_ERROR_POINTER_MAX];
+            pointer_key(ptr, base, key);
+            return gp_error_set(v->err, GP_EINVAL, ptr, "unknown field; expected one of %s",
+                                expected_list);
+        }
+    }
+    return 0;
+}
+
+static int get_object(validator *v, const json_t *parent, const char *base, const char *key,
+                      int required, const json_t **out, char *ptr)
+{
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(parent, key);
+    *out = NULL;
+    if (!value) {
+        if (required)
+            return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected an object");
+        return 0;
+    }
+    if (!json_is_object(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an object, got %s", type_phrase(value));
+    *out = value;
+    return 0;
+}
+
+/* Reads a required finite number that must be > lower (or >= lower when `inclusive`). */
+static int get_number(validator *v, const json_t *obj, const char *base, const char *key,
+                      double lower, int inclusive, double *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    const char *bound = inclusive ? ">=" : ">";
+    if (!value)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected a number %s %g", bound, lower);
+    if (!json_is_number(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be a number %s %g, got %s", bound, lower,
+                            type_phrase(value));
+    double x = json_number_value(value);
+    if (!isfinite(x) || (inclusive ? !(x >= lower) : !(x > lower)))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be %s %g, got %.17g", bound, lower, x);
+    *out = x;
+    return 0;
+}
+
+static int get_finite(validator *v, const json_t *obj, const char *base, const char *key,
+                      double *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    if (!value)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected a number");
+    if (!json_is_number(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be a number, got %s", type_phrase(value));
+    *out = json_number_value(value);
+    return 0;
+}
+
+/* Reads the "kind"/"law" discriminator of obj and matches it against `names`. */
+static int get_choice(validator *v, const json_t *obj, const char *base, const char *key,
+                      const char *const *names, const char *expected_list, int *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    if (!value)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected one of %s", expected_list);
+    if (!json_is_string(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be one of %s, got %s", expected_list,
+                            type_phrase(value));
+    for (int i = 0; names[i]; i++) {
+        if (strcmp(names[i], json_string_value(value)) == 0) {
+            *out = i;
+            return 0;
+        }
+    }
+    return gp_error_set(v->err, GP_EINVAL, ptr, "must be one of %s, got \"%.64s\"", expected_list,
+                        json_string_value(value));
+}
+
+static int parse_domain(validator *v, const json_t *inputs, const char *base, gp_domain *dom)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "domain", 1, &obj, ptr);
+    if (rc)
+        return rc;
+    static const char *const members[] = {"width", "height", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "width, height")))
+        return rc;
+    if ((rc = get_number(v, obj, ptr, "width", 0.0, 0, &dom->width)))
+        return rc;
+    return get_number(v, obj, ptr, "height", 0.0, 0, &dom->height);
+}
+
+static int parse_histogram(validator *v, const json_t *obj, const char *base, gp_distribution *d)
+{
+    char ptr[GP_ERROR_POINTER_MAX], bin_ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, "bins");
+    const json_t *bins = json_object_get(obj, "bins");
+    if (!bins)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected an array of {min, max, p}");
+    if (!json_is_array(bins))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an array of {min, max, p}, got %s",
+                            type_phrase(bins));
+    size_t n = json_array_size(bins);
+    if (n == 0)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must hold at least one bin");
+    if (n > v->max_bins)
+        return gp_error_set(v->err, GP_ETOOBIG, ptr, "has %zu bins, more than the limit of %zu", n,
+                            v->max_bins);
+    d->bins = calloc(n, sizeof *d->bins);
+    if (!d->bins)
+        return gp_error_set(v->err, GP_ENOMEM, ptr, "out of memory for %zu bins", n);
+    d->nbins = n;
+    static const char *const members[] = {"min", "max", "p", NULL};
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *bin = json_array_get(bins, i);
+        gp_bin *b = &d->bins[i];
+        int rc;
+        pointer_index(bin_ptr, ptr, i);
+        if (!json_is_object(bin))
+            return gp_error_set(v->err, GP_EINVAL, bin_ptr, "must be an object {min, max, p}, got %s",
+                                type_phrase(bin));
+        if ((rc = check_members(v, bin, bin_ptr, members, "min, max, p")) ||
+            (rc = get_number(v, bin, bin_ptr, "min", 0.0, 0, &b->min)) ||
+            (rc = get_number(v, bin, bin_ptr, "max", b->min, 0, &b->max)) ||
+            (rc = get_number(v, bin, bin_ptr, "p", 0.0, 1, &b->p)))
+            return rc;
+        if (b->p > 1.0) {
+            char p_ptr[GP_ERROR_POINTER_MAX];
+            pointer_key(p_ptr, bin_ptr, "p");
+            return gp_error_set(v->err, GP_EINVAL, p_ptr, "must be <= 1, got %.17g", b->p);
+        }
+        if (i > 0 && b->min < d->bins[i - 1].max) {
+            char min_ptr[GP_ERROR_POINTER_MAX];
+            pointer_key(min_ptr, bin_ptr, "min");
+            return gp_error_set(v->err, GP_EINVAL, min_ptr,
+                                "must be >= the previous bin's max %.17g (bins sorted, not "
+                                "overlapping), got %.17g",
+                                d->bins[i - 1].max, b->min);
+        }
+        sum += b->p;
+    }
+    if (fabs(sum - 1.0) > GP_SPEC_PROBABILITY_TOL)
+        return gp_error_set(v->err, GP_EINVAL, ptr,
+                            "probabilities must sum to 1 within %g, got %.10g", GP_SPEC_PROBABILITY_TOL,
+                            sum);
+    return 0;
+}
+
+static int parse_distribution(validator *v, const json_t *inputs, const char *base,
+                              gp_distribution *d)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "distribution", 1, &obj, ptr);
+    if (rc)
+        return rc;
+    static const char *const kinds[] = {"constant", "uniform", "histogram", NULL};
+    int kind;
+    if ((rc = get_choice(v, obj, ptr, "kind", kinds, "constant, uniform, histogram", &kind)))
+        return rc;
+    d->kind = (gp_dist_kind)kind;
+    switch (d->kind) {
+    case GP_DIST_CONSTANT: {
+        static const char *const members[] = {"kind", "radius", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "kind, radius")))
+            return rc;
+        return get_number(v, obj, ptr, "radius", 0.0, 0, &d->radius);
+    }
+    case GP_DIST_UNIFORM: {
+        static const char *const members[] = {"kind", "min", "max", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "kind, min, max")))
+            return rc;
+        if ((rc = get_number(v, obj, ptr, "min", 0.0, 0, &d->min)))
+            return rc;
+        return get_number(v, obj, ptr, "max", d->min, 0, &d->max);
+    }
+    case GP_DIST_HISTOGRAM: {
+        static const char *const members[] = {"kind", "bins", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "kind, bins")))
+            return rc;
+        return parse_histogram(v, obj, ptr, d);
+    }
+    }
+    return 0;
+}
+
+static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_joint *j)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "joint", 0, &obj, ptr);
+    memset(j, 0, sizeof *j);
+    if (rc || !obj)
+        return rc;
+    static const char *const laws[] = {"none", "constant", "inverse", "power", NULL};
+    int law;
+    if ((rc = get_choice(v, obj, ptr, "law", laws, "none, constant, inverse, power", &law)))
+        return rc;
+    j->law = (gp_joint_law)law;
+    switch (j->law) {
+    case GP_JOINT_NONE: {
+        static const char *const members[] = {"law", NULL};
+        return check_members(v, obj, ptr, members, "law");
+    }
+    case GP_JOINT_CONSTANT: {
+        static const char *const members[] = {"law", "value", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "law, value")))
+            return rc;
+        return get_number(v, obj, ptr, "value", 0.0, 1, &j->value);
+    }
+    case GP_JOINT_INVERSE: {
+        static const char *const members[] = {"law", "k", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "law, k")))
+            return rc;
+        return get_number(v, obj, ptr, "k", 0.0, 1, &j->k);
+    }
+    case GP_JOINT_POWER: {
+        static const char *const members[] = {"law", "k", "exponent", NULL};
+        if ((rc = check_members(v, obj, ptr, members, "law, k, exponent")))
+            return rc;
+        if ((rc = get_number(v, obj, ptr, "k", 0.0, 1, &j->k)))
+            return rc;
+        return get_finite(v, obj, ptr, "exponent", &j->exponent);
+    }
+    }
+    return 0;
+}
+
+static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band)
+{
+    char ptr[GP_ERROR_POINTER_MAX], band_ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "front", 0, &obj, ptr);
+    *band = 0;
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"level_band", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "level_band")))
+        return rc;
+    const json_t *value = json_object_get(obj, "level_band");
+    if (!value)
+        return 0;
+    pointer_key(band_ptr, ptr, "level_band");
+    if (!json_is_integer(value))
+        return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %s",
+                            GP_SPEC_MAX_LEVEL_BAND, type_phrase(value));
+    json_int_t n = json_integer_value(value);
+    if (n < 0 || n > GP_SPEC_MAX_LEVEL_BAND)
+        return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %lld",
+                            GP_SPEC_MAX_LEVEL_BAND, (long long)n);
+    *band = (uint32_t)n;
+    return 0;
+}
+
+static int parse_seed(validator *v, const json_t *inputs, const char *base, uint64_t *seed)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, "seed");
+    const json_t *value = json_object_get(inputs, "seed");
+    *seed = GP_SPEC_DEFAULT_SEED;
+    if (!value)
+        return 0;
+    if (!json_is_integer(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an integer >= 0, got %s",
+                            type_phrase(value));
+    json_int_t s = json_integer_value(value);
+    if (s < 0)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an integer >= 0, got %lld", (long long)s);
+    *seed = (uint64_t)s;
+    return 0;
+}
+
+double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
+                              const gp_joint *joint)
+{
+    double mean_R2 = gp_distribution_mean_packing_r2(dist, joint);
+    return EXPECTED_FILL * gp_domain_area(domain) / (M_PI * mean_R2);
+}
+
+/* Checks that spans the fields: the law fits the domain, j(r) stays finite on the
+ * support, the expected disk count is under the cap. */
+static int check_whole(validator *v, const char *base, gp_spec *spec)
+{
+    char dist_ptr[GP_ERROR_POINTER_MAX], joint_ptr[GP_ERROR_POINTER_MAX],
+        domain_ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(dist_ptr, base, "distribution");
+    pointer_key(joint_ptr, base, "joint");
+    pointer_key(domain_ptr, base, "domain");
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(&spec->dist, &r_min, &r_max);
+    if (!(r_max > 0.0))
+        return gp_error_set(v->err, GP_EINVAL, dist_ptr, "must give some bin a probability > 0");
+    gp_joint_packing_range(&spec->joint, r_min, r_max, &R_min, &R_max);
+    if (!isfinite(R_max) || !isfinite(R_min))
+        return gp_error_set(v->err, GP_EINVAL, joint_ptr,
+                            "gives a non-finite thickness on the radius range [%g, %g]", r_min, r_max);
+    double side = spec->domain.width < spec->domain.height ? spec->domain.width : spec->domain.height;
+    if (2.0 * R_max > side)
+        return gp_error_set(v->err, GP_EINVAL, dist_ptr,
+                            "the largest packing disk (diameter %g, grain radius up to %g plus "
+                            "joint) must fit in the domain, whose smaller side is %g",
+                            2.0 * R_max, r_max, side);
+    spec->expected_disks = gp_spec_expected_disks(&spec->domain, &spec->dist, &spec->joint);
+    if (!(spec->expected_disks <= (double)v->max_disks))
+        return gp_error_set(v->err, GP_ETOOBIG, domain_ptr,
+                            "about %.3g disks expected, more than the limit of %zu; use a smaller "
+                            "domain or larger grains",
+                            spec->expected_disks, v->max_disks);
+    return 0;
+}
+
+static int parse_root(validator *v, const json_t *root, gp_spec *spec)
+{
+    if (!json_is_object(root))
+        return gp_error_set(v->err, GP_EINVAL, "", "must be an object {\"inputs\": {...}}, got %s",
+                            type_phrase(root));
+    const json_t *inputs = root;
+    const char *base = "";
+    const json_t *wrapped = json_object_get(root, "inputs");
+    if (wrapped) {
+        /* an OGC API - Processes execute request: outputs/response/subscriber are allowed
+         * and have no effect on the packing */
+        static const char *const members[] = {"inputs", "outputs", "response", "subscriber", NULL};
+        int rc = check_members(v, root, "", members, "inputs, outputs, response, subscriber");
+        if (rc)
+            return rc;
+        if (!json_is_object(wrapped))
+            return gp_error_set(v->err, GP_EINVAL, "/inputs", "must be an object, got %s",
+                                type_phrase(wrapped));
+        inputs = wrapped;
+        base = "/inputs";
+    }
+    static const char *const members[] = {"domain", "distribution", "joint", "seed", "front", NULL};
+    int rc;
+    if ((rc = check_members(v, inputs, base, members, "domain, distribution, joint, seed, front")) ||
+        (rc = parse_domain(v, inputs, base, &spec->domain)) ||
+        (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
+        (rc = parse_joint(v, inputs, base, &spec->joint)) ||
+        (rc = parse_seed(v, inputs, base, &spec->seed)) ||
+        (rc = parse_front(v, inputs, base, &spec->level_band)) || (rc = check_whole(v, base, spec)))
+        return rc;
+    if (gp_distribution_prepare(&spec->dist))
+        return gp_error_set(v->err, GP_ENOMEM, "", "out of memory");
+    return 0;
+}
+
+int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
+                  gp_error *err)
+{
+    memset(spec, 0, sizeof *spec);
+    validator v = {err, GP_SPEC_DEFAULT_MAX_DISKS, GP_SPEC_DEFAULT_MAX_BINS};
+    if (limits && limits->max_disks)
+        v.max_disks = limits->max_disks;
+    if (limits && limits->max_bins)
+        v.max_bins = limits->max_bins;
+    json_error_t jerr;
+    json_t *root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!root)
+        return gp_error_set(err, GP_EPARSE, "", "line %d, column %d: %s", jerr.line, jerr.column,
+                            jerr.text);
+    int rc = parse_root(&v, root, spec);
+    json_decref(root);
+    if (rc)
+        gp_spec_free(spec);
+    return rc;
+}
+
+int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
+                      gp_error *err)
+{
+    memset(spec, 0, sizeof *spec);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return gp_error_set(err, GP_EIO, NULL, "cannot open %s: %s", path, strerror(errno));
+    char *text = NULL;
+    size_t len = 0, cap = 0;
+    int rc = 0;
+    for (;;) {
+        if (len + 4096 > cap) {
+            cap = cap ? cap * 2 : 65536;
+            char *grown = realloc(text, cap);
+            if (!grown) {
+                rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory reading %s", path);
+                break;
+            }
+            text = grown;
+        }
+        size_t got = fread(text + len, 1, cap - len, f);
+        len += got;
+        if (got == 0) {
+            if (ferror(f))
+                rc = gp_error_set(err, GP_EIO, NULL, "cannot read %s: %s", path, strerror(errno));
+            break;
+        }
+    }
+    fclose(f);
+    if (rc == 0)
+        rc = gp_spec_parse(text, len, limits, spec, err);
+    free(text);
+    return rc;
+}
+
+void gp_spec_free(gp_spec *spec)
+{
+    gp_distribution_free(&spec->dist);
+    memset(spec, 0, sizeof *spec);
+}

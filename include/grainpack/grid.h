@@ -1,0 +1,70 @@
+/* grid.h - the bucket grid of SPEC §3.4: square cells of side 2 R_max over the domain,
+ * each holding the disks whose centre it contains, so that every disk a candidate can
+ * touch lies in the 3x3 cells around the candidate's centre. */
+#ifndef GRAINPACK_GRID_H
+#define GRAINPACK_GRID_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/disk.h"
+#include "grainpack/domain.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GP_GRID_NONE (-1)
+
+/* Cells are singly linked lists threaded through `next`, indexed by disk. The grid does
+ * not own the disks; it owns `head` and `next`. */
+typedef struct gp_grid {
+    double cell;       /* side of a cell, >= 2 R_max */
+    double inv_cell;
+    int32_t nx, ny;    /* cells along x and y */
+    int32_t *head;     /* nx * ny first disks, GP_GRID_NONE when empty */
+    int32_t *next;     /* per disk: the next disk of its cell */
+    size_t capacity;   /* entries allocated in next */
+    const gp_domain *domain; /* borrowed: the domain the candidates must stay in */
+} gp_grid;
+
+/* Sets up an empty grid for disks of packing radius at most R_max in `domain` (borrowed,
+ * must outlive the grid), with room for `capacity` disks (grown on demand by insert).
+ * Returns 0, GP_ENOMEM, or GP_ETOOBIG when the grid would exceed max_cells cells. */
+int gp_grid_init(gp_grid *grid, const gp_domain *domain, double R_max, size_t capacity,
+                 size_t max_cells);
+
+void gp_grid_free(gp_grid *grid);
+
+/* Makes room for disks with ids below `capacity`; returns 0 or GP_ENOMEM. */
+int gp_grid_reserve(gp_grid *grid, size_t capacity);
+
+/* Inserts disk `id` centred at (x, y) (room must have been reserved). */
+void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y);
+
+/* Removes disk `id`, which was inserted with centre (x, y). */
+void gp_grid_remove(gp_grid *grid, int32_t id, double x, double y);
+
+/* The first disk of `disks` overlapping the candidate packing disk (x, y, R), skipping
+ * ids skip_a and skip_b, searched in the report's order (own cell, the four edge
+ * neighbours, the four corners); GP_GRID_NONE if there is none. Does not test the domain. */
+int32_t gp_grid_first_overlap(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                              double R, int32_t skip_a, int32_t skip_b);
+
+/* All disks overlapping the candidate, as above; writes at most `cap` ids to `out` and
+ * returns how many overlap. */
+size_t gp_grid_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                        double R, int32_t skip_a, int32_t skip_b, int32_t *out, size_t cap);
+
+/* The index (iy * nx + ix) of the cell holding point (x, y); points outside the domain
+ * go to the nearest cell. */
+size_t gp_grid_cell(const gp_grid *grid, double x, double y);
+
+/* The report's search order around a cell: itself, the four edge neighbours, the four
+ * corners, as (dx, dy) offsets. */
+extern const int8_t gp_grid_search_order[9][2];
+
+#ifdef __cplusplus
+}
+#endif
+#endif

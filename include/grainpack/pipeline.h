@@ -1,0 +1,45 @@
+/* pipeline.h - one job from spec to result: pack, then statistics. The service and the
+ * command line call this very function. */
+#ifndef GRAINPACK_PIPELINE_H
+#define GRAINPACK_PIPELINE_H
+
+#include "grainpack/error.h"
+#include "grainpack/pack.h"
+#include "grainpack/progress.h"
+#include "grainpack/spec.h"
+#include "grainpack/stats.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GP_MAX_STAGES 8
+
+/* Wall-clock time spent in one stage. */
+typedef struct gp_stage_time {
+    const char *stage; /* static string: "pack", "stats", ... */
+    double seconds;
+} gp_stage_time;
+
+typedef struct gp_result {
+    gp_packing packing;   /* owned */
+    gp_pack_stats stats;  /* owned */
+    gp_stage_time timings[GP_MAX_STAGES];
+    int ntimings;
+} gp_result;
+
+/* Runs every stage the spec asks for. `max_disks` caps the packing (0: none). On success
+ * returns 0 and `result` owns everything in it (free with gp_result_free); on failure
+ * returns the failing stage's code with err filled, and `result` is zeroed. */
+int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
+                    gp_result *result, gp_error *err);
+
+void gp_result_free(gp_result *result);
+
+/* Seconds spent in `stage`, or 0 if it did not run. */
+double gp_result_stage_seconds(const gp_result *result, const char *stage);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,29 @@
+/* progress.h - how a long stage reports how far it got and learns that it must stop. */
+#ifndef GRAINPACK_PROGRESS_H
+#define GRAINPACK_PROGRESS_H
+
+#ifdef __cplusplus
+#include <atomic>
+typedef std::atomic_int gp_cancel_flag;
+#else
+#include <stdatomic.h>
+typedef atomic_int gp_cancel_flag;
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Everything is optional: a NULL gp_progress, a NULL report or a NULL cancel all work.
+ * Stages call report() from the thread that runs them, a few hundred times per second at
+ * most, and read *cancel as often; a nonzero *cancel makes the stage return GP_ECANCELED. */
+typedef struct gp_progress {
+    void (*report)(void *ctx, const char *stage, double fraction); /* fraction in [0,1] */
+    void *ctx;
+    const gp_cancel_flag *cancel;
+} gp_progress;
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,66 @@
+/* spec.h - the job spec: JSON text -> struct gp_spec, validated with messages that name
+ * the offending field by JSON pointer. Shared by the command line and the service. */
+#ifndef GRAINPACK_SPEC_H
+#define GRAINPACK_SPEC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/distribution.h"
+#include "grainpack/domain.h"
+#include "grainpack/error.h"
+#include "grainpack/joint.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Caps a spec must respect. Zero fields take the defaults below. */
+typedef struct gp_spec_limits {
+    size_t max_disks; /* reject specs expected to pack more disks than this */
+    size_t max_bins;  /* reject histograms with more bins than this */
+} gp_spec_limits;
+
+#define GP_SPEC_DEFAULT_MAX_DISKS ((size_t)20000000)
+#define GP_SPEC_DEFAULT_MAX_BINS ((size_t)10000)
+#define GP_SPEC_DEFAULT_SEED 1
+/* The widest level band a spec may ask for: beyond a few levels the fill stops being
+ * layered and density no longer improves (see bench/). */
+#define GP_SPEC_MAX_LEVEL_BAND 16
+/* Probabilities of a histogram must sum to 1 within this (SPEC §2); never renormalised. */
+#define GP_SPEC_PROBABILITY_TOL 1e-6
+
+typedef struct gp_spec {
+    gp_domain domain;
+    gp_distribution dist; /* owned; prepared for sampling */
+    gp_joint joint;       /* GP_JOINT_NONE when the spec has no joint */
+    uint64_t seed;
+    uint32_t level_band;   /* see gp_pack_params; "front": {"level_band": n} */
+    double expected_disks; /* estimate used against the cap */
+} gp_spec;
+
+/* Parses and validates a job spec: either the whole execute request {"inputs": {...}}
+ * or the bare inputs object. `limits` may be NULL (defaults). On success returns 0 and
+ * `spec` owns its distribution (free with gp_spec_free). On failure returns GP_EPARSE
+ * (not JSON), GP_EINVAL (invalid field) or GP_ETOOBIG (over a cap), fills err with the
+ * JSON pointer of the field (as it appears in `text`) and what was expected, and leaves
+ * `spec` zeroed. */
+int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
+                  gp_error *err);
+
+/* Reads and parses a spec file (as gp_spec_parse; GP_EIO if it cannot be read). */
+int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
+                      gp_error *err);
+
+/* The expected number of disks: a packing density of ~0.86 over the mean packing-disk
+ * area. Used for the disk cap and for capacity guesses. */
+double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
+                              const gp_joint *joint);
+
+/* Frees what the spec owns and zeroes it. */
+void gp_spec_free(gp_spec *spec);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

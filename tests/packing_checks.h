@@ -1,0 +1,112 @@
+/* packing_checks.h - independent checks of a packing's geometry, shared by the tests.
+ * They use neither the bucket grid nor the contact predicate of the library, so that a
+ * bug there cannot hide itself. */
+#ifndef GRAINPACK_TESTS_PACKING_CHECKS_H
+#define GRAINPACK_TESTS_PACKING_CHECKS_H
+
+#include <stdlib.h>
+
+#include "grainpack/disk.h"
+#include "grainpack/distribution.h"
+#include "grainpack/domain.h"
+#include "grainpack/spec.h"
+
+/* Two packing disks overlap when their centres are closer than (R1 + R2)(1 - 1e-9).
+ * Why 1e-9: disks placed tangent to each other are exactly in contact in real numbers
+ * and computed in doubles, so their distance comes out within a few ulps of the
+ * coordinates (below 1e-12 of a radius in every test here); 1e-9 leaves a thousandfold
+ * margin over that rounding while any real overlap, however small to the eye, is far
+ * larger. The library's own tolerance (GP_CONTACT_RTOL) is the same value. */
+#define TEST_OVERLAP_RTOL 1e-9
+/* A disk may cross the boundary by at most this fraction of its radius, for the same
+ * reason: disks touching a wall are placed at exactly R from it, up to rounding. */
+#define TEST_BOUNDARY_RTOL 1e-9
+
+
+
+typedef struct x_index {
+    double x;
+    size_t index;
+} x_index;
+
+static int compare_x(const void *pa, const void *pb)
+{
+    double xa = ((const x_index *)pa)->x, xb = ((const x_index *)pb)->x;
+    return xa < xb ? -1 : (xa > xb ? 1 : 0);
+}
+
+/* The number of overlapping pairs, found by a sweep along x (no grid). *worst gets the
+ * largest relative overlap 1 - d / (R1 + R2) over all pairs (negative: none touch). */
+static inline size_t count_overlaps(const gp_disk *disks, size_t n, double *worst)
+{
+    x_index *order = malloc((n ? n : 1) * sizeof *order);
+    double R_max = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        order[i] = (x_index){disks[i].x, i};
+        if (disks[i].R > R_max)
+            R_max = disks[i].R;
+    }
+    qsort(order, n, sizeof *order, compare_x);
+    size_t bad = 0;
+    *worst = -1.0;
+    for (size_t a = 0; a < n; a++) {
+        const gp_disk *p = &disks[order[a].index];
+        for (size_t b = a + 1; b < n; b++) {
+            const gp_disk *q = &disks[order[b].index];
+            if (q->x - p->x >= p->R + R_max)
+                break;
+            double d = sqrt((q->x - p->x) * (q->x - p->x) + (q->y - p->y) * (q->y - p->y));
+            double rel = 1.0 - d / (p->R + q->R);
+            if (rel > *worst)
+                *worst = rel;
+            if (rel > TEST_OVERLAP_RTOL)
+                bad++;
+        }
+    }
+    free(order);
+    return bad;
+}
+
+/* The number of packing disks sticking out of the rectangle by more than the tolerance. */
+static inline size_t count_outside(const gp_disk *disks, size_t n, const gp_domain *dom)
+{
+    size_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        const gp_disk *d = &disks[i];
+        double slack = d->R * TEST_BOUNDARY_RTOL;
+        if (d->x - d->R < -slack || d->y - d->R < -slack || d->x + d->R > dom->width + slack ||
+            d->y + d->R > dom->height + slack)
+            bad++;
+    }
+    return bad;
+}
+
+/* Whether r can be drawn from the law: in one of its bins of positive probability, in
+ * its interval, or equal to its radius. */
+static inline int radius_in_support(const gp_distribution *dist, double r)
+{
+    switch (dist->kind) {
+    case GP_DIST_CONSTANT: return r == dist->radius;
+    case GP_DIST_UNIFORM: return r >= dist->min && r <= dist->max;
+    case GP_DIST_HISTOGRAM:
+        for (size_t i = 0; i < dist->nbins; i++)
+            if (dist->bins[i].p > 0.0 && r >= dist->bins[i].min && r <= dist->bins[i].max)
+                return 1;
+        return 0;
+    }
+    return 0;
+}
+
+/* Loads examples/<name>.json, aborting the test program if it cannot. */
+static inline void load_example(const char *name, gp_spec *spec)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s.json", GP_EXAMPLES_DIR, name);
+    gp_error err;
+    if (gp_spec_load_file(path, NULL, spec, &err)) {
+        fprintf(stderr, "cannot load %s: %s %s\n", path, err.pointer, err.message);
+        exit(2);
+    }
+}
+
+#endif

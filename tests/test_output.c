@@ -1,0 +1,182 @@
+/* test_output.c - statistics on hand-made packings, the writers (CSV read back exactly,
+ * JSON parsed, SVG counted), and determinism: same seed, same bytes; other seed, other
+ * bytes. */
+#include <jansson.h>
+#include <stdlib.h>
+
+#include "check.h"
+#include "grainpack/io.h"
+#include "grainpack/pipeline.h"
+#include "grainpack/stats.h"
+#include "packing_checks.h"
+
+/* Renders a result in a format into a malloc'd, NUL-terminated buffer. */
+static char *render(gp_format format, const gp_spec *spec, const gp_result *result, size_t *len)
+{
+    char *buf = NULL;
+    FILE *f = open_memstream(&buf, len);
+    CHECK(gp_write_result(f, format, spec, result) == 0);
+    fclose(f);
+    return buf;
+}
+
+/* Loads examples/<name>.json and runs the pipeline on it. */
+static void run_example(const char *name, gp_spec *spec, gp_result *result)
+{
+    load_example(name, spec);
+    gp_error err;
+    CHECK_MSG(gp_pipeline_run(spec, 0, NULL, result, &err) == 0, "%s: %s", name, err.message);
+}
+
+static void test_statistics_of_a_hand_made_packing(void)
+{
+    gp_domain dom = {10, 10};
+    gp_bin bins[2] = {{1.0, 2.0, 0.5}, {2.0, 3.0, 0.5}};
+    gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
+    gp_disk disks[4] = {{2, 2, 1.5, 2.0}, {7, 2, 1.0, 1.5}, {2, 7, 2.5, 2.5}, {7, 7, 3.0, 3.0}};
+    gp_packing pk = {.disks = disks, .count = 4};
+    gp_pack_stats st;
+    CHECK(gp_pack_stats_compute(&dom, &dist, &pk, &st) == 0);
+    CHECK(st.count == 4 && st.nbins == 2);
+    CHECK_NEAR(st.packing_density, M_PI * (4 + 2.25 + 6.25 + 9) / 100.0, 1e-15);
+    CHECK_NEAR(st.grain_fraction, M_PI * (2.25 + 1 + 6.25 + 9) / 100.0, 1e-15);
+    /* r = 1.5, 1.0 in [1, 2); 2.5 in [2, 3); 3.0 is the closed end of the last bin */
+    CHECK(st.bins[0].count == 2 && st.bins[1].count == 2);
+    CHECK(st.bins[0].achieved == 0.5 && st.bins[0].z == 0.0);
+    CHECK(st.chi2 == 0.0 && st.dof == 1 && st.p_value == 1.0);
+    CHECK(st.r_min == 1.0 && st.r_max == 3.0 && st.r_mean == 2.0);
+    gp_pack_stats_free(&st);
+
+    /* three in the first bin: chi2 = (3-2)^2/2 + (1-2)^2/2 = 1, z = (0.75-0.5)/sqrt(.25/4) */
+    disks[3].r = 1.2;
+    CHECK(gp_pack_stats_compute(&dom, &dist, &pk, &st) == 0);
+    CHECK(st.bins[0].count == 3);
+    CHECK_NEAR(st.chi2, 1.0, 1e-15);
+    CHECK_NEAR(st.bins[0].z, 1.0, 1e-12);
+    CHECK_NEAR(st.p_value, gp_chi2_upper_tail(1.0, 1), 1e-15);
+    gp_pack_stats_free(&st);
+}
+
+static void test_same_seed_same_bytes_other_seed_other_bytes(void)
+{
+    gp_spec spec;
+    load_example("iron", &spec);
+    gp_result a, b, c;
+    gp_error err;
+    CHECK(gp_pipeline_run(&spec, 0, NULL, &a, &err) == 0);
+    CHECK(gp_pipeline_run(&spec, 0, NULL, &b, &err) == 0);
+    spec.seed = 2;
+    CHECK(gp_pipeline_run(&spec, 0, NULL, &c, &err) == 0);
+    spec.seed = 1;
+    for (int f = GP_FORMAT_JSON; f <= GP_FORMAT_SVG; f++) {
+        size_t la, lb, lc;
+        char *ta = render((gp_format)f, &spec, &a, &la), *tb = render((gp_format)f, &spec, &b, &lb);
+        spec.seed = 2;
+        char *tc = render((gp_format)f, &spec, &c, &lc);
+        spec.seed = 1;
+        CHECK_MSG(la == lb && memcmp(ta, tb, la) == 0, "%s differs between two runs", gp_format_name((gp_format)f));
+        CHECK_MSG(la != lc || memcmp(ta, tc, la) != 0, "%s is the same for seeds 1 and 2", gp_format_name((gp_format)f));
+        free(ta);
+        free(tb);
+        free(tc);
+    }
+    gp_result_free(&a);
+    gp_result_free(&b);
+    gp_result_free(&c);
+    gp_spec_free(&spec);
+}
+
+static void test_csv_reads_back_to_the_exact_disks(void)
+{
+    gp_spec spec;
+    gp_result r;
+    run_example("variable", &spec, &r);
+    size_t len;
+    char *text = render(GP_FORMAT_CSV, &spec, &r, &len);
+    CHECK(strncmp(text, "x,y,r,R\n", 8) == 0);
+    char *line = text + 8;
+    size_t rows = 0, exact = 0;
+    while (*line) {
+        double x, y, rr, R;
+        if (sscanf(line, "%lf,%lf,%lf,%lf", &x, &y, &rr, &R) == 4 && rows < r.packing.count) {
+            const gp_disk *d = &r.packing.disks[rows];
+            exact += x == d->x && y == d->y && rr == d->r && R == d->R;
+        }
+        rows++;
+        line = strchr(line, '\n') + 1;
+    }
+    CHECK(rows == r.packing.count && exact == rows);
+    free(text);
+    gp_result_free(&r);
+    gp_spec_free(&spec);
+}
+
+static void test_json_has_the_disks_and_every_statistic(void)
+{
+    gp_spec spec;
+    gp_result r;
+    run_example("iron", &spec, &r);
+    size_t len;
+    char *text = render(GP_FORMAT_JSON, &spec, &r, &len);
+    json_error_t jerr;
+    json_t *root = json_loadb(text, len, 0, &jerr);
+    CHECK_MSG(root != NULL, "%s", jerr.text);
+    json_t *st = json_object_get(root, "statistics");
+    CHECK(json_integer_value(json_object_get(st, "count")) == (json_int_t)r.packing.count);
+    CHECK(json_array_size(json_object_get(root, "disks")) == r.packing.count);
+    CHECK(json_real_value(json_object_get(st, "packing_density")) == r.stats.packing_density);
+    json_t *bins = json_object_get(json_object_get(st, "distribution"), "bins");
+    CHECK(json_array_size(bins) == 12);
+    json_int_t total = 0;
+    for (size_t i = 0; i < json_array_size(bins); i++)
+        total += json_integer_value(json_object_get(json_array_get(bins, i), "count"));
+    CHECK(total == (json_int_t)r.packing.count);
+    CHECK(json_object_get(st, "front") != NULL && json_object_get(json_object_get(st, "distribution"), "chi2") != NULL);
+    json_t *first = json_array_get(json_object_get(root, "disks"), 0);
+    CHECK(json_real_value(json_object_get(first, "x")) == r.packing.disks[0].x);
+    json_decref(root);
+    free(text);
+    gp_result_free(&r);
+    gp_spec_free(&spec);
+}
+
+static void test_svg_draws_one_circle_per_grain_with_legend(void)
+{
+    gp_spec spec;
+    gp_result r;
+    run_example("iron", &spec, &r);
+    size_t len;
+    char *text = render(GP_FORMAT_SVG, &spec, &r, &len);
+    size_t circles = 0;
+    for (char *p = text; (p = strstr(p, "<circle")); p++)
+        circles++;
+    CHECK(circles == r.packing.count);
+    CHECK(strstr(text, "<svg xmlns=\"http://www.w3.org/2000/svg\"") != NULL);
+    CHECK(strstr(text, "grain radius") != NULL && strstr(text, "</svg>") != NULL);
+    CHECK(strstr(text, "stroke=\"") != NULL); /* the joint ring */
+    /* compact: well under 100 bytes per grain */
+    CHECK_MSG(len < 100 * r.packing.count + 10000, "%zu bytes for %zu grains", len, r.packing.count);
+    free(text);
+    gp_result_free(&r);
+    gp_spec_free(&spec);
+}
+
+static void test_format_names(void)
+{
+    gp_format f;
+    CHECK(gp_format_parse("csv", &f) == 0 && f == GP_FORMAT_CSV);
+    CHECK(gp_format_parse("svg", &f) == 0 && f == GP_FORMAT_SVG);
+    CHECK(gp_format_parse("xml", &f) == GP_EINVAL);
+    CHECK_STR(gp_format_media_type(GP_FORMAT_SVG), "image/svg+xml");
+}
+
+int main(void)
+{
+    RUN(test_statistics_of_a_hand_made_packing);
+    RUN(test_same_seed_same_bytes_other_seed_other_bytes);
+    RUN(test_csv_reads_back_to_the_exact_disks);
+    RUN(test_json_has_the_disks_and_every_statistic);
+    RUN(test_svg_draws_one_circle_per_grain_with_legend);
+    RUN(test_format_names);
+    return check_status();
+}
