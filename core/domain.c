@@ -15,9 +15,3 @@ double gp_domain_area(const gp_domain *domain)
 {
     return domain->width * domain->height;
 }
-
-int gp_domain_contains_disk(const gp_domain *domain, double x, double y, double R, double slack)
-{
-    return x - R >= -slack && y - R >= -slack && x + R <= domain->width + slack &&
-           y + R <= domain->height + slack;
-}

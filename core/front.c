@@ -1,4 +1,4 @@
-/* front.c - the advancing front: loops of nodes, per-level heaps of segments, barriers. */
+/* front.c - the advancing front: loops of nodes, per-level lists of segments, barriers. */
 #include "front.h"
 
 #include <math.h>
@@ -13,29 +13,31 @@
 #define TOUCH_RTOL 1e-7
 
 int front_init(front *f, const gp_disk *const *disks, const uint32_t *const *levels,
-               const gp_grid *grid, size_t disk_capacity)
+               const gp_grid *grid, size_t disk_capacity, double R_lo, double R_hi)
 {
     memset(f, 0, sizeof *f);
+    f->class_lo = R_lo;
+    f->class_scale = R_hi > R_lo ? FRONT_FAIL_CLASSES / (R_hi - R_lo) : 0.0;
     f->disks = disks;
     f->levels = levels;
     f->grid = grid;
     f->free_node = FRONT_NONE;
-    size_t ncells = (size_t)grid->nx * (size_t)grid->ny;
+    size_t ncells = grid->ncells;
     f->barrier_head = malloc(ncells * sizeof *f->barrier_head);
     if (!f->barrier_head)
         return GP_ENOMEM;
     memset(f->barrier_head, 0xff, ncells * sizeof *f->barrier_head); /* FRONT_NONE */
+    f->free_link = FRONT_NONE;
     return front_reserve_disks(f, disk_capacity);
 }
 
 void front_free(front *f)
 {
-    for (uint32_t i = 0; i < f->nbuckets; i++)
-        free(f->buckets[i].failed);
     free(f->buckets);
     free(f->nodes);
     free(f->first_node);
     free(f->barrier_head);
+    free(f->links);
     memset(f, 0, sizeof *f);
 }
 
@@ -68,76 +70,74 @@ static int grow_buckets(front *f, uint32_t level)
     front_bucket *grown = realloc(f->buckets, n * sizeof *grown);
     if (!grown)
         return GP_ENOMEM;
-    for (uint32_t i = f->nbuckets; i < n; i++)
-        grown[i] = (front_bucket){FRONT_NONE, NULL, 0, 0};
+    for (uint32_t i = f->nbuckets; i < n; i++) {
+        front_bucket *b = &grown[i];
+        b->untried = FRONT_NONE;
+        for (int c = 0; c < FRONT_FAIL_CLASSES; c++)
+            b->failed[c] = FRONT_NONE;
+        memset(b->failed_mask, 0, sizeof b->failed_mask);
+    }
     f->buckets = grown;
     f->nbuckets = n;
     return 0;
 }
 
-/* The heap of failed segments is 4-ary: half the depth of a binary one, and the four
- * children of an entry share a cache line or two. */
-#define HEAP_ARITY 4
-
-static void heap_place(front *f, front_bucket *b, uint32_t pos, front_failed entry)
+static int fail_class(const front *f, double R)
 {
-    b->failed[pos] = entry;
-    f->nodes[entry.node].heap_pos = pos;
+    double c = (R - f->class_lo) * f->class_scale;
+    if (!(c > 0.0))
+        return 0;
+    return c >= FRONT_FAIL_CLASSES - 1 ? FRONT_FAIL_CLASSES - 1 : (int)c;
 }
 
-static void sift_up(front *f, front_bucket *b, uint32_t pos)
+/* The list node u belongs to (untried, or the failed list of its class). */
+static int32_t *list_of(front *f, int32_t u)
 {
-    front_failed entry = b->failed[pos];
-    while (pos > 0) {
-        uint32_t parent = (pos - 1) / HEAP_ARITY;
-        if (!(entry.fail_R > b->failed[parent].fail_R))
-            break;
-        heap_place(f, b, pos, b->failed[parent]);
-        pos = parent;
-    }
-    heap_place(f, b, pos, entry);
+    front_node *n = &f->nodes[u];
+    front_bucket *b = &f->buckets[n->level];
+    return n->state == SEG_UNTRIED ? &b->untried : &b->failed[n->fail_class];
 }
 
-static void sift_down(front *f, front_bucket *b, uint32_t pos)
+static void list_push(front *f, int32_t *head, int32_t u)
 {
-    front_failed entry = b->failed[pos];
-    for (;;) {
-        uint32_t first = HEAP_ARITY * pos + 1;
-        if (first >= b->nfailed)
-            break;
-        uint32_t end = first + HEAP_ARITY < b->nfailed ? first + HEAP_ARITY : b->nfailed;
-        uint32_t best = first;
-        for (uint32_t c = first + 1; c < end; c++)
-            if (b->failed[c].fail_R > b->failed[best].fail_R)
-                best = c;
-        if (!(b->failed[best].fail_R > entry.fail_R))
-            break;
-        heap_place(f, b, pos, b->failed[best]);
-        pos = best;
-    }
-    heap_place(f, b, pos, entry);
+    front_node *n = &f->nodes[u];
+    n->list_prev = FRONT_NONE;
+    n->list_next = *head;
+    if (*head != FRONT_NONE)
+        f->nodes[*head].list_prev = u;
+    *head = u;
 }
 
-static void untried_unlink(front *f, front_bucket *b, int32_t u)
+static void list_unlink(front *f, int32_t *head, int32_t u)
 {
     front_node *n = &f->nodes[u];
     if (n->list_prev != FRONT_NONE)
         f->nodes[n->list_prev].list_next = n->list_next;
     else
-        b->untried = n->list_next;
+        *head = n->list_next;
     if (n->list_next != FRONT_NONE)
         f->nodes[n->list_next].list_prev = n->list_prev;
 }
 
-static void failed_remove(front *f, front_bucket *b, int32_t u)
+static void set_class_bit(front_bucket *b, int c)
 {
-    uint32_t pos = f->nodes[u].heap_pos;
-    front_failed last = b->failed[--b->nfailed];
-    if (last.node == u)
-        return;
-    heap_place(f, b, pos, last);
-    sift_up(f, b, pos);
-    sift_down(f, b, f->nodes[last.node].heap_pos);
+    if (b->failed[c] != FRONT_NONE)
+        b->failed_mask[c / 64] |= (uint64_t)1 << (c % 64);
+    else
+        b->failed_mask[c / 64] &= ~((uint64_t)1 << (c % 64));
+}
+
+/* The highest non-empty failure class of a bucket at or below `below`, or -1. */
+static int highest_class(const front_bucket *b, int below)
+{
+    for (int w = below / 64; w >= 0; w--) {
+        uint64_t bits = b->failed_mask[w];
+        if (w == below / 64 && below % 64 != 63)
+            bits &= ((uint64_t)1 << (below % 64 + 1)) - 1;
+        if (bits)
+            return w * 64 + 63 - __builtin_clzll(bits);
+    }
+    return -1;
 }
 
 /* Puts node u's fresh segment at the head of its level's untried list. */
@@ -146,15 +146,10 @@ static int bucket_push(front *f, int32_t u)
     front_node *n = &f->nodes[u];
     if (grow_buckets(f, n->level))
         return GP_ENOMEM;
-    front_bucket *b = &f->buckets[n->level];
     n->state = SEG_UNTRIED;
     n->fail_R = INFINITY;
     n->blocker = FRONT_NONE;
-    n->list_prev = FRONT_NONE;
-    n->list_next = b->untried;
-    if (b->untried != FRONT_NONE)
-        f->nodes[b->untried].list_prev = u;
-    b->untried = u;
+    list_push(f, &f->buckets[n->level].untried, u);
     if (n->level < f->low)
         f->low = n->level;
     return 0;
@@ -162,17 +157,15 @@ static int bucket_push(front *f, int32_t u)
 
 static void bucket_remove(front *f, int32_t u)
 {
-    front_bucket *b = &f->buckets[f->nodes[u].level];
-    if (f->nodes[u].state == SEG_UNTRIED)
-        untried_unlink(f, b, u);
-    else
-        failed_remove(f, b, u);
+    list_unlink(f, list_of(f, u), u);
+    if (f->nodes[u].state == SEG_FAILED)
+        set_class_bit(&f->buckets[f->nodes[u].level], f->nodes[u].fail_class);
 }
 
 uint32_t front_low_level(front *f)
 {
     while (f->low < f->nbuckets && f->buckets[f->low].untried == FRONT_NONE &&
-           f->buckets[f->low].nfailed == 0)
+           highest_class(&f->buckets[f->low], FRONT_FAIL_CLASSES - 1) < 0)
         f->low++;
     return f->low;
 }
@@ -184,34 +177,40 @@ int32_t front_top(const front *f, uint32_t level)
     const front_bucket *b = &f->buckets[level];
     if (b->untried != FRONT_NONE)
         return b->untried;
-    return b->nfailed ? b->failed[0].node : FRONT_NONE;
+    int c = highest_class(b, FRONT_FAIL_CLASSES - 1);
+    return c < 0 ? FRONT_NONE : b->failed[c];
+}
+
+int32_t front_next_eligible(const front *f, uint32_t level, double R)
+{
+    if (level >= f->nbuckets)
+        return FRONT_NONE;
+    const front_bucket *b = &f->buckets[level];
+    if (b->untried != FRONT_NONE)
+        return b->untried;
+    int c = highest_class(b, FRONT_FAIL_CLASSES - 1);
+    int cR = fail_class(f, R);
+    if (c > cR)
+        return b->failed[c]; /* the whole class failed for radii above R */
+    if (c == cR) /* members of R's own class may have failed above or below R */
+        for (int32_t u = b->failed[c]; u != FRONT_NONE; u = f->nodes[u].list_next)
+            if (f->nodes[u].fail_R > R)
+                return u;
+    return FRONT_NONE;
 }
 
 void front_mark_failed(front *f, int32_t u, double R)
 {
     front_node *n = &f->nodes[u];
-    front_bucket *b = &f->buckets[n->level];
-    if (n->state == SEG_FAILED) {
-        if (R < n->fail_R) {
-            n->fail_R = R;
-            b->failed[n->heap_pos].fail_R = R;
-            sift_down(f, b, n->heap_pos);
-        }
+    if (n->state == SEG_FAILED && !(R < n->fail_R))
         return;
-    }
-    if (b->nfailed == b->capacity) {
-        uint32_t cap = b->capacity ? 2 * b->capacity : 16;
-        front_failed *heap = realloc(b->failed, cap * sizeof *heap);
-        if (!heap)
-            return; /* stays untried: it will merely be tried again */
-        b->failed = heap;
-        b->capacity = cap;
-    }
-    untried_unlink(f, b, u);
+    bucket_remove(f, u);
     n->state = SEG_FAILED;
     n->fail_R = R;
-    b->failed[b->nfailed] = (front_failed){R, u};
-    sift_up(f, b, b->nfailed++);
+    n->fail_class = (uint8_t)fail_class(f, R);
+    front_bucket *b = &f->buckets[n->level];
+    list_push(f, &b->failed[n->fail_class], u);
+    set_class_bit(b, n->fail_class);
 }
 
 /* ---- barriers: the part of a segment that its two disks do not cover ---- */
@@ -234,37 +233,93 @@ static int uncovered_part(const front *f, int32_t u, double *px, double *py, dou
     return 1;
 }
 
-static void register_barrier(front *f, int32_t u)
+/* The cells a barrier is registered in: every cell a centre can lie in and still bring a
+ * disk of radius <= R_max (half a cell) onto the uncovered part, i.e. the cells meeting
+ * the part's bounding box grown by R_max. The part is shorter than a cell side (a closing
+ * joins disks that both met one candidate disk, and the initial front stops where the
+ * next disk would not fit), so that is at most 3x3 cells and usually 2x2; a query then
+ * reads its own cell's list only. */
+static void barrier_cells(const front *f, const double *part, int32_t range[4])
 {
-    double px, py, qx, qy;
+    const gp_grid *g = f->grid;
+    double reach = 0.5 * g->cell;
+    double lo_x = fmin(part[0], part[2]) - reach, hi_x = fmax(part[0], part[2]) + reach;
+    double lo_y = fmin(part[1], part[3]) - reach, hi_y = fmax(part[1], part[3]) + reach;
+    gp_grid_coords(g, lo_x, lo_y, &range[0], &range[1]);
+    gp_grid_coords(g, hi_x, hi_y, &range[2], &range[3]);
+}
+
+/* Whether a disk of radius R (the smallest the law draws) can reach the segment between
+ * disks a and b without overlapping them. The deepest it can go is tangent to both, its
+ * centre at height h over the line a-b; it reaches the line when h < R, or when the gap
+ * is wider than 2 R. h - R grows with R, so no larger disk can reach a gap the smallest
+ * cannot: such narrow gaps, the common case after a closing, need no barrier. */
+static int gap_crossable(const gp_disk *a, const gp_disk *b, double d, double R)
+{
+    double ra = a->R + R, rb = b->R + R;
+    if (d >= ra + rb)
+        return 1;
+    double along = (ra * ra - rb * rb + d * d) / (2.0 * d);
+    double h2 = ra * ra - along * along;
+    return h2 < R * R;
+}
+
+static int register_barrier(front *f, int32_t u)
+{
+    double part[4];
     front_node *n = &f->nodes[u];
     n->barrier_cell = FRONT_NONE;
-    if (!uncovered_part(f, u, &px, &py, &qx, &qy))
-        return;
-    /* The uncovered part is shorter than a cell side (2 R_max): a closing joins disks that
-     * both met one candidate disk, and the initial front stops where the next disk would
-     * not fit. So a disk of radius <= R_max crossing it has its centre within the 3x3
-     * cells around the cell of the part's midpoint. */
-    size_t cell = gp_grid_cell(f->grid, 0.5 * (px + qx), 0.5 * (py + qy));
-    n->barrier_cell = (int32_t)cell;
-    n->gap[0] = px;
-    n->gap[1] = py;
-    n->gap[2] = qx;
-    n->gap[3] = qy;
-    n->next_barrier = f->barrier_head[cell];
-    f->barrier_head[cell] = u;
+    if (!uncovered_part(f, u, &part[0], &part[1], &part[2], &part[3]) ||
+        !gap_crossable(&(*f->disks)[n->disk], &(*f->disks)[f->nodes[n->next].disk], n->length,
+                       f->class_lo))
+        return 0;
+    memcpy(n->gap, part, sizeof part);
+    int32_t range[4];
+    barrier_cells(f, part, range);
+    for (int32_t cy = range[1]; cy <= range[3]; cy++) {
+        for (int32_t cx = range[0]; cx <= range[2]; cx++) {
+            int32_t link = f->free_link;
+            if (link == FRONT_NONE) {
+                if (f->nlinks == f->link_capacity) {
+                    size_t cap = 2 * f->link_capacity + 256;
+                    front_link *grown = realloc(f->links, cap * sizeof *grown);
+                    if (!grown)
+                        return GP_ENOMEM;
+                    f->links = grown;
+                    f->link_capacity = cap;
+                }
+                link = (int32_t)f->nlinks++;
+            } else {
+                f->free_link = f->links[link].next;
+            }
+            size_t cell = gp_grid_index(f->grid, cx, cy);
+            f->links[link] = (front_link){u, f->barrier_head[cell]};
+            f->barrier_head[cell] = link;
+        }
+    }
+    n->barrier_cell = 1;
+    return 0;
 }
 
 static void unregister_barrier(front *f, int32_t u)
 {
-    int32_t cell = f->nodes[u].barrier_cell;
-    if (cell == FRONT_NONE)
+    front_node *n = &f->nodes[u];
+    if (n->barrier_cell == FRONT_NONE)
         return;
-    int32_t *link = &f->barrier_head[cell];
-    while (*link != u)
-        link = &f->nodes[*link].next_barrier;
-    *link = f->nodes[u].next_barrier;
-    f->nodes[u].barrier_cell = FRONT_NONE;
+    int32_t range[4];
+    barrier_cells(f, n->gap, range);
+    for (int32_t cy = range[1]; cy <= range[3]; cy++) {
+        for (int32_t cx = range[0]; cx <= range[2]; cx++) {
+            int32_t *link = &f->barrier_head[gp_grid_index(f->grid, cx, cy)];
+            while (f->links[*link].node != u)
+                link = &f->links[*link].next;
+            int32_t gone = *link;
+            *link = f->links[gone].next;
+            f->links[gone].next = f->free_link;
+            f->free_link = gone;
+        }
+    }
+    n->barrier_cell = FRONT_NONE;
 }
 
 /* Squared distance from (x, y) to the segment [p, q]. */
@@ -280,20 +335,13 @@ static double dist2_to_segment(double x, double y, double px, double py, double 
 
 int32_t front_barrier_crossed(const front *f, double x, double y, double R, int32_t skip)
 {
-    const gp_grid *g = f->grid;
-    size_t cell = gp_grid_cell(g, x, y);
-    int32_t ix = (int32_t)(cell % (size_t)g->nx), iy = (int32_t)(cell / (size_t)g->nx);
     double reach = R * (1.0 - GP_CONTACT_RTOL);
-    for (int k = 0; k < 9; k++) {
-        int32_t cx = ix + gp_grid_search_order[k][0], cy = iy + gp_grid_search_order[k][1];
-        if (cx < 0 || cy < 0 || cx >= g->nx || cy >= g->ny)
-            continue;
-        for (int32_t u = f->barrier_head[(size_t)cy * (size_t)g->nx + (size_t)cx]; u != FRONT_NONE;
-             u = f->nodes[u].next_barrier) {
-            const double *part = f->nodes[u].gap;
-            if (u != skip && dist2_to_segment(x, y, part[0], part[1], part[2], part[3]) < reach * reach)
-                return u;
-        }
+    for (int32_t link = f->barrier_head[gp_grid_cell(f->grid, x, y)]; link != FRONT_NONE;
+         link = f->links[link].next) {
+        int32_t u = f->links[link].node;
+        const double *part = f->nodes[u].gap;
+        if (u != skip && dist2_to_segment(x, y, part[0], part[1], part[2], part[3]) < reach * reach)
+            return u;
     }
     return FRONT_NONE;
 }
@@ -308,7 +356,8 @@ static int attach_segment(front *f, int32_t u, int touching)
     front_node *n = &f->nodes[u];
     const gp_disk *da = &(*f->disks)[n->disk], *db = &(*f->disks)[f->nodes[n->next].disk];
     double dx = db->x - da->x, dy = db->y - da->y;
-    n->length = sqrt(dx * dx + dy * dy);
+    /* touching disks are R_a + R_b apart up to rounding; no need for the square root */
+    n->length = touching ? da->R + db->R : sqrt(dx * dx + dy * dy);
     n->ux = n->length > 0.0 ? dx / n->length : 0.0;
     n->uy = n->length > 0.0 ? dy / n->length : 0.0;
     n->level = (*f->levels)[n->disk] + (*f->levels)[f->nodes[n->next].disk];
@@ -316,9 +365,7 @@ static int attach_segment(front *f, int32_t u, int touching)
         return GP_ENOMEM;
     f->active++;
     n->barrier_cell = FRONT_NONE;
-    if (!touching)
-        register_barrier(f, u);
-    return 0;
+    return touching ? 0 : register_barrier(f, u);
 }
 
 static void detach_segment(front *f, int32_t u)
@@ -423,7 +470,7 @@ int front_add_loop(front *f, const int32_t *disks, size_t n)
     return 0;
 }
 
-int front_place(front *f, int32_t u, int32_t c)
+int front_place(front *f, int32_t u, int32_t c, int c_touches_b)
 {
     int32_t v = f->nodes[u].next;
     int32_t w = new_node(f, c, f->nodes[u].loop);
@@ -434,7 +481,7 @@ int front_place(front *f, int32_t u, int32_t c)
     f->nodes[w].next = v;
     f->nodes[u].next = w;
     f->nodes[v].prev = w;
-    if (attach_segment(f, u, 1) || attach_segment(f, w, 1))
+    if (attach_segment(f, u, 1) || attach_segment(f, w, c_touches_b))
         return GP_ENOMEM;
     return 0;
 }

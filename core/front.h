@@ -5,10 +5,11 @@
  * segment u -> u.next of node u has the filled region on its right. A disk can sit on
  * several loops (where a loop was pinched in two), once per node.
  *
- * Segments waiting to be worked sit in one bucket per level (SPEC §3.3). The segment to
- * try first in a level is its newest untried one, else the one that failed for the
- * largest radius; so "the first segment of a level that has not failed for a radius <= R"
- * is read in O(1), and updated in O(1) (untried) or O(log n) (failed).
+ * Segments waiting to be worked sit in one bucket per level (SPEC §3.3): the untried ones
+ * in a list, newest first, and the ones that failed in lists by the radius they failed
+ * for, quantised into FRONT_FAIL_CLASSES classes over the law's range with a bit mask of
+ * the classes in use. "The next segment of a level that has not failed for a radius <= R"
+ * is then found, and every update made, in O(1).
  *
  * A segment whose disks do not touch spans a void. Such a "barrier" is registered in the
  * bucket grid so that no later disk is placed across it into the filled side; with it,
@@ -33,29 +34,34 @@ typedef struct front_node {
     double ux, uy, length;  /* unit vector a -> b and distance of the centres */
     uint32_t level;         /* level(a) + level(b) (report eq. 5) */
     uint8_t state;          /* SEG_UNTRIED, SEG_FAILED or SEG_FROZEN */
+    uint8_t fail_class;     /* SEG_FAILED: class of fail_R, the list it is in */
     double fail_R;          /* smallest packing radius that failed here; +inf if untried */
-    int32_t list_prev, list_next; /* SEG_UNTRIED: neighbours in the level's untried list */
-    uint32_t heap_pos;      /* SEG_FAILED: position in the level's heap of failed segments */
+    int32_t list_prev, list_next; /* neighbours in its list (untried, or failed of a class) */
     int32_t blocker;        /* SEG_FAILED: the disk last in the way, tested first next time */
-    int32_t next_barrier;   /* next barrier registered in the same grid cell */
-    int32_t barrier_cell;   /* grid cell of the registration, FRONT_NONE if the disks touch */
+    int32_t barrier_cell;   /* FRONT_NONE unless the segment is a registered barrier */
     double gap[4];          /* the uncovered part of a barrier: px, py, qx, qy */
 } front_node;
 
 enum { SEG_UNTRIED = 0, SEG_FAILED, SEG_FROZEN };
 
+/* Classes of failure radii: 128 over the law's packing-radius range, so a class spans
+ * under 1% of it and the list of the class holding R (the only one whose members may or
+ * may not be eligible for R) stays short. */
+#define FRONT_FAIL_CLASSES 128
+
 /* The segments of one level still to work: the untried ones in a list, newest first (the
  * front sweeps on from the last placement, as the report's in-place list does), and the
- * ones that failed in a max-heap on the radius they failed for. */
-typedef struct front_failed {
-    double fail_R;          /* copied from the node, so that sifting reads the heap only */
-    int32_t node;
-} front_failed;
+ * failed ones in one list per class of the radius they failed for. */
+/* One registration of a barrier in one grid cell. */
+typedef struct front_link {
+    int32_t node; /* whose segment is the barrier */
+    int32_t next; /* next registration in the same cell; next free one when unused */
+} front_link;
 
 typedef struct front_bucket {
     int32_t untried;        /* newest untried segment, FRONT_NONE if none */
-    front_failed *failed;   /* 4-ary max-heap on fail_R */
-    uint32_t nfailed, capacity;
+    int32_t failed[FRONT_FAIL_CLASSES]; /* newest failed segment of each class */
+    uint64_t failed_mask[FRONT_FAIL_CLASSES / 64]; /* bit c set: class c not empty */
 } front_bucket;
 
 /* The front borrows the disks, levels and grid of its packer (they must outlive it) and
@@ -71,18 +77,22 @@ typedef struct front {
     uint32_t next_loop;
     front_bucket *buckets;
     uint32_t nbuckets, low;       /* no bucket below `low` holds a segment */
+    double class_lo, class_scale; /* fail class = (fail_R - class_lo) * class_scale */
     size_t active;                /* segments in the buckets, still to be worked */
     size_t frozen;                /* segments given up on */
 
     int32_t *first_node;          /* per disk: one of its nodes, FRONT_NONE if off the front */
     size_t disk_capacity;
-    int32_t *barrier_head;        /* per grid cell */
+    int32_t *barrier_head;        /* per grid cell: first registration (front_link) */
+    front_link *links;
+    size_t nlinks, link_capacity;
+    int32_t free_link;
 } front;
 
-/* Sets up an empty front over `grid`, with per-disk room for `disk_capacity` disks.
- * Returns 0 or GP_ENOMEM (front_free is safe either way). */
+/* Sets up an empty front over `grid`, with per-disk room for `disk_capacity` disks, for
+ * packing radii in [R_lo, R_hi]. Returns 0 or GP_ENOMEM (front_free is safe either way). */
 int front_init(front *f, const gp_disk *const *disks, const uint32_t *const *levels,
-               const gp_grid *grid, size_t disk_capacity);
+               const gp_grid *grid, size_t disk_capacity, double R_lo, double R_hi);
 void front_free(front *f);
 
 /* Makes per-disk room for `capacity` disks; returns 0 or GP_ENOMEM. */
@@ -97,15 +107,20 @@ int front_add_loop(front *f, const int32_t *disks, size_t n);
 /* The lowest level holding a segment to work (meaningful while f->active > 0). */
 uint32_t front_low_level(front *f);
 
-/* The node whose segment to try first at `level`, or FRONT_NONE. */
+/* The node whose segment to try first at `level` (the newest untried one, else one that
+ * failed for a radius of the highest class), or FRONT_NONE when the level is empty. */
 int32_t front_top(const front *f, uint32_t level);
+
+/* A node of `level` whose segment has not failed for a radius <= R (the newest untried
+ * one first, then failed ones from the highest class down), or FRONT_NONE. */
+int32_t front_next_eligible(const front *f, uint32_t level, double R);
 
 /* Records that node u's segment failed for packing radius R (it keeps the smallest). */
 void front_mark_failed(front *f, int32_t u, double R);
 
-/* Disk c was placed against node u's segment (a, b): the segment becomes a -> c -> b.
- * Returns 0 or GP_ENOMEM. */
-int front_place(front *f, int32_t u, int32_t c);
+/* Disk c was placed against node u's segment (a, b), touching a (and b too when
+ * `c_touches_b`): the segment becomes a -> c -> b. Returns 0 or GP_ENOMEM. */
+int front_place(front *f, int32_t u, int32_t c, int c_touches_b);
 
 /* The node of `disk` on the same loop as node u, or FRONT_NONE. */
 int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u);

@@ -21,11 +21,18 @@ int gp_grid_init(gp_grid *grid, const gp_domain *domain, double R_max, size_t ca
         return GP_ETOOBIG;
     grid->nx = (int32_t)nx;
     grid->ny = (int32_t)ny;
-    size_t cells = (size_t)grid->nx * (size_t)grid->ny;
-    grid->head = malloc(cells * sizeof *grid->head);
+    grid->stride = grid->nx + 2;
+    grid->ncells = (size_t)grid->stride * (size_t)(grid->ny + 2);
+    /* the report's search order around cell (i, j): itself, (i+1,j), (i,j+1), (i-1,j),
+     * (i,j-1), then the corners (i+1,j+1), (i-1,j+1), (i-1,j-1), (i+1,j-1) */
+    static const int8_t order[9][2] = {{0, 0}, {1, 0},  {0, 1},   {-1, 0}, {0, -1},
+                                       {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+    for (int k = 0; k < 9; k++)
+        grid->around[k] = order[k][0] + order[k][1] * grid->stride;
+    grid->head = malloc(grid->ncells * sizeof *grid->head);
     if (!grid->head)
         return GP_ENOMEM;
-    memset(grid->head, 0xff, cells * sizeof *grid->head); /* all GP_GRID_NONE */
+    memset(grid->head, 0xff, grid->ncells * sizeof *grid->head); /* all GP_GRID_NONE */
     int rc = gp_grid_reserve(grid, capacity);
     if (rc)
         gp_grid_free(grid);
@@ -51,22 +58,6 @@ int gp_grid_reserve(gp_grid *grid, size_t capacity)
     return 0;
 }
 
-static int32_t clamp_cell(double v, int32_t n)
-{
-    if (!(v >= 0.0))
-        return 0;
-    if (v >= (double)n)
-        return n - 1;
-    return (int32_t)v;
-}
-
-size_t gp_grid_cell(const gp_grid *grid, double x, double y)
-{
-    int32_t ix = clamp_cell(x * grid->inv_cell, grid->nx);
-    int32_t iy = clamp_cell(y * grid->inv_cell, grid->ny);
-    return (size_t)iy * (size_t)grid->nx + (size_t)ix;
-}
-
 void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y)
 {
     size_t c = gp_grid_cell(grid, x, y);
@@ -83,32 +74,22 @@ void gp_grid_remove(gp_grid *grid, int32_t id, double x, double y)
         *link = grid->next[id];
 }
 
-/* The report's search order around cell (i, j): itself, (i+1,j), (i,j+1), (i-1,j),
- * (i,j-1), then the corners (i+1,j+1), (i-1,j+1), (i-1,j-1), (i+1,j-1). */
-const int8_t gp_grid_search_order[9][2] = {{0, 0}, {1, 0},  {0, 1},   {-1, 0}, {0, -1},
-                                           {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
-
-/* Visits the 3x3 cells around (x, y); for each disk overlapping (x, y, R) other than the
+/* Visits the 3x3 cells around (x, y) in the report's order (own cell, the four edge
+ * neighbours, the four corners); for each disk overlapping (x, y, R) other than the
  * skipped two, stores it (if room) and stops after the first when `first_only`. */
 static size_t scan_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
                             double R, int32_t skip_a, int32_t skip_b, int first_only,
                             int32_t *out, size_t cap)
 {
-    int32_t ix = clamp_cell(x * grid->inv_cell, grid->nx);
-    int32_t iy = clamp_cell(y * grid->inv_cell, grid->ny);
+    const int32_t *center = grid->head + gp_grid_cell(grid, x, y);
+    double shrink = 1.0 - GP_CONTACT_RTOL;
     size_t found = 0;
     for (int k = 0; k < 9; k++) {
-        int32_t cx = ix + gp_grid_search_order[k][0], cy = iy + gp_grid_search_order[k][1];
-        if (cx < 0 || cy < 0 || cx >= grid->nx || cy >= grid->ny)
-            continue;
-        for (int32_t id = grid->head[(size_t)cy * (size_t)grid->nx + (size_t)cx];
-             id != GP_GRID_NONE; id = grid->next[id]) {
-            if (id == skip_a || id == skip_b)
-                continue;
+        for (int32_t id = center[grid->around[k]]; id != GP_GRID_NONE; id = grid->next[id]) {
             const gp_disk *d = &disks[id];
             double dx = d->x - x, dy = d->y - y;
-            double reach = (d->R + R) * (1.0 - GP_CONTACT_RTOL);
-            if (dx * dx + dy * dy >= reach * reach)
+            double reach = (d->R + R) * shrink;
+            if (dx * dx + dy * dy >= reach * reach || id == skip_a || id == skip_b)
                 continue;
             if (found < cap)
                 out[found] = id;

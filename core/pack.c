@@ -161,7 +161,7 @@ static int build_initial_front(packer *pk)
      * before it on the edge (two disks touching a wall with radii R, R' have centres
      * 2 sqrt(R R') apart along it; the new one goes as near the corner as that allows,
      * which is tangent to the previous disk unless a tiny one sits between two large
-     * ones), until the next one would hit the next corner's disk or leave the domain. */
+     * ones), until it would leave the domain past the next corner's disk. */
     size_t loop_len = 0, loop_cap = 256;
     int32_t *loop = malloc(loop_cap * sizeof *loop);
     if (!loop)
@@ -199,8 +199,25 @@ static int build_initial_front(packer *pk)
                 if (reach > t)
                     t = reach;
             }
-            double cx = vx[i] + t * ex[i] + R * nx[i], cy = vy[i] + t * ey[i] + R * ny[i];
-            if (!fits(pk, cx, cy, R, -1, -1, FRONT_NONE))
+            /* any other disk in the way (the last ones of the previous edge, near the
+             * corner) pushes the disk on along the wall, past it; the edge ends when the
+             * disk would leave the domain, at the next corner */
+            double cx, cy;
+            int32_t q;
+            for (;;) {
+                cx = vx[i] + t * ex[i] + R * nx[i];
+                cy = vy[i] + t * ey[i] + R * ny[i];
+                if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
+                    break;
+                q = gp_grid_first_overlap(&pk->grid, pk->disks, cx, cy, R, -1, -1);
+                if (q == GP_GRID_NONE)
+                    break;
+                const gp_disk *dq = &pk->disks[q];
+                double tq = (dq->x - vx[i]) * ex[i] + (dq->y - vy[i]) * ey[i];
+                double hq = (dq->x - vx[i]) * nx[i] + (dq->y - vy[i]) * ny[i];
+                t = tq + sqrt((R + dq->R) * (R + dq->R) - (R - hq) * (R - hq));
+            }
+            if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
                 break;
             int32_t id = add_disk(pk, cx, cy, 0);
             if (id < 0) {
@@ -238,7 +255,8 @@ static int32_t seg_to(const packer *pk, int32_t u)
  * exists and fits. The disk that was in the way last time, then the disks next to a and b
  * on the loop, are the likeliest to be in the way, so they are tested before the grid;
  * a disk found in the way is remembered in the node. */
-static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double *x, double *y)
+static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double *x, double *y,
+                         int *touches_b)
 {
     front_node *nodes = pk->fr.nodes;
     const front_node *n = &nodes[u];
@@ -246,7 +264,8 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     const gp_disk *da = &pk->disks[a], *db = &pk->disks[b];
     /* SPEC §3.1 with the segment's direction and length computed once per segment */
     double ra = da->R + R, rb = db->R + R, d = n->length;
-    if (d > ra + rb) {
+    *touches_b = !(d > ra + rb);
+    if (!*touches_b) {
         if (!bridge_gap)
             return 0;
         *x = da->x + ra * n->ux;
@@ -291,23 +310,24 @@ static int try_segment(packer *pk, int32_t u, int bridge_gap)
 {
     int32_t a = seg_from(pk, u), b = seg_to(pk, u);
     double x, y;
+    int touches_b;
     pk->out->attempts++;
     pk->work_since_report++;
-    if (!find_position(pk, u, pk->pending_R, bridge_gap, &x, &y))
+    if (!find_position(pk, u, pk->pending_R, bridge_gap, &x, &y, &touches_b))
         return 0;
     uint32_t la = pk->level[a], lb = pk->level[b];
     /* our definition of report eq. 6: one more than the lower of the two */
     int32_t c = add_disk(pk, x, y, (la < lb ? la : lb) + 1);
     if (c < 0)
         return c;
-    return front_place(&pk->fr, u, c) ? front_oom(pk) : 1;
+    return front_place(&pk->fr, u, c, touches_b) ? front_oom(pk) : 1;
 }
 
 /* The criterion of our eq. 7: the free space between pi and the two disks of s. */
 static double closing_gap(const gp_disk *d1, const gp_disk *d2, const gp_disk *di)
 {
-    return hypot(di->x - d1->x, di->y - d1->y) - d1->R - di->R +
-           hypot(di->x - d2->x, di->y - d2->y) - d2->R - di->R;
+    double x1 = di->x - d1->x, y1 = di->y - d1->y, x2 = di->x - d2->x, y2 = di->y - d2->y;
+    return sqrt(x1 * x1 + y1 * y1) - d1->R - di->R + sqrt(x2 * x2 + y2 * y2) - d2->R - di->R;
 }
 
 /* Collects in pk->conflicts the disks the pending radius meets at (x, y) when placed
@@ -433,8 +453,7 @@ static int run_front(packer *pk)
             front_mark_failed(&pk->fr, first, pk->pending_R);
         for (uint32_t level = low; level <= low + band && !placed; level++) {
             int32_t s;
-            while (!placed && (s = front_top(&pk->fr, level)) != FRONT_NONE &&
-                   pk->fr.nodes[s].fail_R > pk->pending_R) {
+            while (!placed && (s = front_next_eligible(&pk->fr, level, pk->pending_R)) != FRONT_NONE) {
                 placed = try_segment(pk, s, 0);
                 if (placed < 0)
                     return placed;
@@ -499,7 +518,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
         pk.conflicts = malloc(pk.conflict_capacity * sizeof *pk.conflicts);
         if (!pk.conflicts || !pk.disks || !pk.level || !pk.closings ||
             front_init(&pk.fr, (const gp_disk *const *)&pk.disks, (const uint32_t *const *)&pk.level,
-                       &pk.grid, capacity))
+                       &pk.grid, capacity, R_min, R_max))
             rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for %zu disks", capacity);
     }
     if (rc == 0) {

@@ -23,7 +23,7 @@ static void setup(fixture *fx, int n)
     fx->levels = calloc(64, sizeof *fx->levels);
     gp_grid_init(&fx->grid, &fx->dom, 1.0, 64, 1 << 16);
     front_init(&fx->f, (const gp_disk *const *)&fx->disks, (const uint32_t *const *)&fx->levels,
-               &fx->grid, 64);
+               &fx->grid, 64, 0.05, 1.0);
     for (int i = 0; i < 64; i++)
         front_disk_added(&fx->f, i);
     int32_t ids[64];
@@ -80,7 +80,7 @@ static void test_place_inserts_the_disk_between_the_segment_ends(void)
     setup(&fx, 6);
     fx.disks[6] = (gp_disk){21, 19, 1, 1};
     fx.levels[6] = 1;
-    CHECK(front_place(&fx.f, node_of(&fx.f, 2), 6) == 0);
+    CHECK(front_place(&fx.f, node_of(&fx.f, 2), 6, 1) == 0);
     int32_t order[64];
     int n = loop_disks(&fx.f, node_of(&fx.f, 0), order);
     CHECK(n == 7 && order[2] == 2 && order[3] == 6 && order[4] == 3);
@@ -156,19 +156,29 @@ static void test_newest_untried_first_then_largest_failed_radius(void)
     /* all six are untried at level 0: the newest (disk 5's segment) comes first */
     int32_t top = front_top(&fx.f, 0);
     CHECK(fx.f.nodes[top].disk == 5);
-    front_mark_failed(&fx.f, top, 0.5);
+    front_mark_failed(&fx.f, top, 0.6);
     CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 4);
-    /* once all have failed, the one that failed for the largest radius is first */
+    /* an untried segment is eligible for any radius, a failed one only below its radius */
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.9)].disk == 4);
+    /* once all have failed (4 for 0.5, 3 for 0.4, ... 0 for 0.1), the one that failed for
+     * the largest radius is first */
     for (int i = 4; i >= 0; i--)
         front_mark_failed(&fx.f, front_top(&fx.f, 0), 0.1 * (i + 1));
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 5);  /* failed for 0.5 */
-    front_mark_failed(&fx.f, node_of(&fx.f, 5), 0.05); /* a smaller failure lowers it */
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 4);  /* failed for 0.5 as well */
+    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 5);
+    CHECK(front_next_eligible(&fx.f, 0, 0.6) == FRONT_NONE);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.55)].disk == 5);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.45)].disk == 5);
+    front_mark_failed(&fx.f, node_of(&fx.f, 5), 0.45); /* a smaller failure lowers it */
+    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 4);  /* failed for 0.5 */
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.449)].disk == 4);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.46)].disk == 4);
+    CHECK(front_next_eligible(&fx.f, 0, 0.5) == FRONT_NONE);
     front_mark_failed(&fx.f, node_of(&fx.f, 4), 0.9);  /* a larger one does not raise it */
     CHECK(fx.f.nodes[node_of(&fx.f, 4)].fail_R == 0.5);
     front_freeze(&fx.f, node_of(&fx.f, 4));
     CHECK(fx.f.active == 5 && fx.f.frozen == 1);
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 3);
+    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 5);
+    CHECK(front_next_eligible(&fx.f, 0, 0.05) != FRONT_NONE);
     teardown(&fx);
 }
 
@@ -186,7 +196,7 @@ static void test_gap_segments_are_barriers_and_touching_ones_are_not(void)
     double x, y;
     CHECK(gp_place_tangent(&fx.disks[0], &fx.disks[1], 4.5, &x, &y));
     fx.disks[6] = (gp_disk){x, y, 4.5, 4.5};
-    CHECK(front_place(&fx.f, node_of(&fx.f, 0), 6) == 0);
+    CHECK(front_place(&fx.f, node_of(&fx.f, 0), 6, 1) == 0);
     CHECK(front_barrier_crossed(&fx.f, mx, my, 0.5, FRONT_NONE) == FRONT_NONE);
     teardown(&fx);
 }

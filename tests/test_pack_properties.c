@@ -96,11 +96,19 @@ static config_summary check_config(const char *label, gp_spec *spec, int seeds, 
 
 static void test_reference_cases_hold_every_property_over_200_seeds(void)
 {
-    static const char *const cases[] = {"fixed", "variable", "iron", "bagi"};
+    /* Floors on the packing density of every seed, about 0.01 under the lowest measured
+     * over these 200 seeds (fixed 0.8762, variable 0.773, iron 0.770, Bagi 0.791): a run
+     * that leaves a wall unfilled or lets the front give up drops far below them. */
+    static const struct {
+        const char *name;
+        double floor;
+    } cases[] = {{"fixed", 0.876}, {"variable", 0.76}, {"iron", 0.76}, {"bagi", 0.78}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         gp_spec spec;
-        load_example(cases[i], &spec);
-        check_config(cases[i], &spec, SEEDS, spec.level_band, 1);
+        load_example(cases[i].name, &spec);
+        config_summary s = check_config(cases[i].name, &spec, SEEDS, spec.level_band, 1);
+        CHECK_MSG(s.min_density >= cases[i].floor, "%s: a seed reached only %.4f", cases[i].name,
+                  s.min_density);
         gp_spec_free(&spec);
     }
 }

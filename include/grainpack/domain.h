@@ -19,8 +19,14 @@ void gp_domain_corner(const gp_domain *domain, int i, double *x, double *y);
 double gp_domain_area(const gp_domain *domain);
 
 /* Whether the disk (x, y, R) lies inside the domain, allowing it to stick out by at most
- * `slack` (a non-negative length; see GP_CONTACT_RTOL in grid.h for the value used). */
-int gp_domain_contains_disk(const gp_domain *domain, double x, double y, double R, double slack);
+ * `slack` (a non-negative length; the packer uses R * GP_CONTACT_RTOL, see disk.h).
+ * Inline: it runs for every candidate disk. */
+static inline int gp_domain_contains_disk(const gp_domain *domain, double x, double y, double R,
+                                          double slack)
+{
+    return x - R >= -slack && y - R >= -slack && x + R <= domain->width + slack &&
+           y + R <= domain->height + slack;
+}
 
 #ifdef __cplusplus
 }

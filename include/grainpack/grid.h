@@ -16,13 +16,18 @@ extern "C" {
 
 #define GP_GRID_NONE (-1)
 
-/* Cells are singly linked lists threaded through `next`, indexed by disk. The grid does
- * not own the disks; it owns `head` and `next`. */
+/* Cells are singly linked lists threaded through `next`, indexed by disk. A border of
+ * always-empty cells surrounds the nx x ny cells over the domain, so that a 3x3 scan
+ * never tests bounds: cell (ix, iy), 0 <= ix < nx, has index (iy + 1) * stride + ix + 1.
+ * The grid does not own the disks; it owns `head` and `next`. */
 typedef struct gp_grid {
     double cell;       /* side of a cell, >= 2 R_max */
     double inv_cell;
-    int32_t nx, ny;    /* cells along x and y */
-    int32_t *head;     /* nx * ny first disks, GP_GRID_NONE when empty */
+    int32_t nx, ny;    /* cells over the domain along x and y */
+    int32_t stride;    /* nx + 2 */
+    size_t ncells;     /* (nx + 2) * (ny + 2), border included */
+    int32_t around[9]; /* index offsets of a cell and its neighbours, in the report's order */
+    int32_t *head;     /* ncells first disks, GP_GRID_NONE when empty */
     int32_t *next;     /* per disk: the next disk of its cell */
     size_t capacity;   /* entries allocated in next */
     const gp_domain *domain; /* borrowed: the domain the candidates must stay in */
@@ -56,13 +61,29 @@ int32_t gp_grid_first_overlap(const gp_grid *grid, const gp_disk *disks, double 
 size_t gp_grid_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
                         double R, int32_t skip_a, int32_t skip_b, int32_t *out, size_t cap);
 
-/* The index (iy * nx + ix) of the cell holding point (x, y); points outside the domain
- * go to the nearest cell. */
-size_t gp_grid_cell(const gp_grid *grid, double x, double y);
+/* The cell (ix, iy) holding point (x, y), 0 <= ix < nx, 0 <= iy < ny; points outside the
+ * domain go to the nearest cell. Inline, as the next two: every grid query starts here. */
+static inline void gp_grid_coords(const gp_grid *grid, double x, double y, int32_t *ix,
+                                  int32_t *iy)
+{
+    double cx = x * grid->inv_cell, cy = y * grid->inv_cell;
+    *ix = !(cx >= 0.0) ? 0 : (cx >= (double)grid->nx ? grid->nx - 1 : (int32_t)cx);
+    *iy = !(cy >= 0.0) ? 0 : (cy >= (double)grid->ny ? grid->ny - 1 : (int32_t)cy);
+}
 
-/* The report's search order around a cell: itself, the four edge neighbours, the four
- * corners, as (dx, dy) offsets. */
-extern const int8_t gp_grid_search_order[9][2];
+/* The index in `head` of cell (ix, iy) (0 <= ix < nx, 0 <= iy < ny). */
+static inline size_t gp_grid_index(const gp_grid *grid, int32_t ix, int32_t iy)
+{
+    return (size_t)(iy + 1) * (size_t)grid->stride + (size_t)(ix + 1);
+}
+
+/* The index in `head` of the cell holding point (x, y) (see gp_grid_coords). */
+static inline size_t gp_grid_cell(const gp_grid *grid, double x, double y)
+{
+    int32_t ix, iy;
+    gp_grid_coords(grid, x, y, &ix, &iy);
+    return gp_grid_index(grid, ix, iy);
+}
 
 #ifdef __cplusplus
 }
