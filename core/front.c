@@ -188,15 +188,12 @@ int32_t front_next_eligible(const front *f, uint32_t level, double R)
     const front_bucket *b = &f->buckets[level];
     if (b->untried != FRONT_NONE)
         return b->untried;
+    /* Only classes above R's count as not having failed for R: members of R's own class
+     * failed for radii within 1/FRONT_FAIL_CLASSES of the law's range of R, and are taken
+     * as failing for R too. Walking that class to tell them apart made the search linear
+     * in the front when many segments had failed for similar radii. */
     int c = highest_class(b, FRONT_FAIL_CLASSES - 1);
-    int cR = fail_class(f, R);
-    if (c > cR)
-        return b->failed[c]; /* the whole class failed for radii above R */
-    if (c == cR) /* members of R's own class may have failed above or below R */
-        for (int32_t u = b->failed[c]; u != FRONT_NONE; u = f->nodes[u].list_next)
-            if (f->nodes[u].fail_R > R)
-                return u;
-    return FRONT_NONE;
+    return c > fail_class(f, R) ? b->failed[c] : FRONT_NONE;
 }
 
 void front_mark_failed(front *f, int32_t u, double R)

@@ -45,8 +45,7 @@ typedef struct front_node {
 enum { SEG_UNTRIED = 0, SEG_FAILED, SEG_FROZEN };
 
 /* Classes of failure radii: 128 over the law's packing-radius range, so a class spans
- * under 1% of it and the list of the class holding R (the only one whose members may or
- * may not be eligible for R) stays short. */
+ * under 1% of it, which is how finely "failed for a radius <= R" is told. */
 #define FRONT_FAIL_CLASSES 128
 
 /* The segments of one level still to work: the untried ones in a list, newest first (the
@@ -112,7 +111,8 @@ uint32_t front_low_level(front *f);
 int32_t front_top(const front *f, uint32_t level);
 
 /* A node of `level` whose segment has not failed for a radius <= R (the newest untried
- * one first, then failed ones from the highest class down), or FRONT_NONE. */
+ * one first, then failed ones from the highest class down), or FRONT_NONE. A failure
+ * radius in the same class as R counts as <= R (see front.c). */
 int32_t front_next_eligible(const front *f, uint32_t level, double R);
 
 /* Records that node u's segment failed for packing radius R (it keeps the smallest). */
