@@ -55,8 +55,9 @@ double gp_distribution_sample(const gp_distribution *dist, gp_rng *rng)
     case GP_DIST_CONSTANT: return dist->radius;
     case GP_DIST_UNIFORM: return dist->min + gp_rng_uniform(rng) * (dist->max - dist->min);
     case GP_DIST_HISTOGRAM: {
-        const gp_bin *bin = &dist->bins[histogram_bin(dist, gp_rng_uniform(rng))];
-        return bin->min + gp_rng_uniform(rng) * (bin->max - bin->min);
+        double u = gp_rng_uniform(rng);
+        const gp_bin *bin = &dist->bins[histogram_bin(dist, u)];
+        return bin->min + (dist->report_same_draw ? u : gp_rng_uniform(rng)) * (bin->max - bin->min);
     }
     }
     return dist->radius;

@@ -133,6 +133,31 @@ static void test_radius_is_uniform_inside_its_bin(void)
     gp_distribution_free(&d);
 }
 
+static void test_report_same_draw_keeps_bins_but_leans_to_bin_tops(void)
+{
+    /* the report's literal r' = r: bin frequencies still right, radii near the tops of
+     * the later bins (the draw that chose bin j lies in [cdf_j-1, cdf_j)) */
+    gp_distribution d = table1();
+    d.report_same_draw = 1;
+    double p;
+    chi_square(&d, 100000, 4, &p, NULL);
+    CHECK(p >= SIGNIFICANCE);
+    gp_rng rng;
+    gp_rng_seed(&rng, 4);
+    double sum_last = 0.0;
+    int n_last = 0;
+    for (int i = 0; i < 100000; i++) {
+        double r = gp_distribution_sample(&d, &rng);
+        if (r >= 1.9) {
+            sum_last += r;
+            n_last++;
+        }
+    }
+    /* the last bin [1.9, 2.0) is chosen by u in [0.92, 1): r = 1.9 + 0.1 u, mean 1.996 */
+    CHECK_NEAR(sum_last / n_last, 1.996, 1e-3);
+    gp_distribution_free(&d);
+}
+
 static void test_uniform_law_passes_chi_square_on_ten_bins(void)
 {
     gp_distribution d = {.kind = GP_DIST_UNIFORM, .min = 0.06, .max = 0.42};
@@ -201,6 +226,7 @@ int main(void)
     RUN(test_table1_with_1000_draws_is_as_close_as_the_report);
     RUN(test_biased_sampler_would_be_caught);
     RUN(test_radius_is_uniform_inside_its_bin);
+    RUN(test_report_same_draw_keeps_bins_but_leans_to_bin_tops);
     RUN(test_uniform_law_passes_chi_square_on_ten_bins);
     RUN(test_constant_law_always_gives_its_radius);
     RUN(test_support_skips_empty_bins_and_mass_below_one_goes_to_last_bin);

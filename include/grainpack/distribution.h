@@ -33,6 +33,11 @@ typedef struct gp_distribution {
     size_t nbins;    /* GP_DIST_HISTOGRAM: bins sorted by min, not overlapping */
     gp_bin *bins;    /* owned; freed by gp_distribution_free */
     double *cdf;     /* owned; cdf[i] = p_0 + .. + p_i, built by gp_distribution_prepare */
+    int report_same_draw; /* GP_DIST_HISTOGRAM: 0 (SPEC §2) places the radius in its bin
+                             with an independent draw; 1 reuses the bin-choosing draw, the
+                             literal "r' = r" of the report, which honours the bin
+                             frequencies but leans to the top of each bin. Only for
+                             reproducing the report's figures (bench/). */
 } gp_distribution;
 
 /* Builds the sampling table of a histogram (no-op for other kinds). Call once after the
