@@ -13,13 +13,18 @@ static const struct {
 
 int gp_format_parse(const char *name, gp_format *out)
 {
-    for (size_t i = 0; i < sizeof formats / sizeof formats[0]; i++) {
+    for (size_t i = 0; i < gp_format_count(); i++) {
         if (strcmp(name, formats[i].name) == 0) {
             *out = (gp_format)i;
             return 0;
         }
     }
     return GP_EINVAL;
+}
+
+size_t gp_format_count(void)
+{
+    return sizeof formats / sizeof formats[0];
 }
 
 const char *gp_format_name(gp_format format)

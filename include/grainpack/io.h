@@ -23,6 +23,9 @@ typedef enum gp_format {
 /* Maps "json", "csv" or "svg" to a format; returns 0 or GP_EINVAL. */
 int gp_format_parse(const char *name, gp_format *out);
 const char *gp_format_name(gp_format format);
+/* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,
+ * so a caller can list them without knowing their names (the service does). */
+size_t gp_format_count(void);
 /* The media type to serve the format with ("text/csv; charset=utf-8", ...). */
 const char *gp_format_media_type(gp_format format);
 

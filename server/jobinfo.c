@@ -1,0 +1,42 @@
+/* jobinfo.c - statusInfo objects (OGC API - Processes, Part 1, statusInfo.yaml). */
+#include "jobinfo.h"
+
+#include <stdio.h>
+
+#include "routes.h"
+
+static void put_time(json_t *obj, const char *key, const char *value)
+{
+    if (value[0]) /* not set yet: omitted, as the OGC schema allows */
+        json_object_set_new(obj, key, json_string(value));
+}
+
+json_t *gp_job_status_info(const gp_job *job)
+{
+    char self[64], results[80], stats[80];
+    snprintf(self, sizeof self, "/jobs/%s", job->id);
+    snprintf(results, sizeof results, "/jobs/%s/results", job->id);
+    snprintf(stats, sizeof stats, "/jobs/%s/statistics", job->id);
+    json_t *links = json_pack("[{s:s, s:s, s:s, s:s}]", "href", self, "rel", "self", "type",
+                              "application/json", "title", "this job's status");
+    if (links && job->status == GP_JOB_SUCCESSFUL) {
+        json_array_append_new(links,
+                              json_pack("{s:s, s:s, s:s, s:s}", "href", results, "rel",
+                                        "http://www.opengis.net/def/rel/ogc/1.0/results", "type",
+                                        "application/json", "title", "the result (?f=json|csv|svg)"));
+        json_array_append_new(links, json_pack("{s:s, s:s, s:s, s:s}", "href", stats, "rel",
+                                               "statistics", "type", "application/json", "title",
+                                               "densities, distribution fidelity, timings"));
+    }
+    json_t *info = json_pack("{s:s, s:s, s:s, s:s, s:s, s:i, s:o}", "processID", GP_PROCESS_ID,
+                             "type", "process", "jobID", job->id, "status",
+                             gp_job_status_name(job->status), "message", job->message,
+                             "progress", job->progress, "links", links);
+    if (!info)
+        return NULL;
+    put_time(info, "created", job->created);
+    put_time(info, "started", job->started);
+    put_time(info, "finished", job->finished);
+    put_time(info, "updated", job->updated);
+    return info;
+}

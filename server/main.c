@@ -1,0 +1,121 @@
+/* main.c - grainpackd: reads its options, opens the store, starts the workers and the
+ * HTTP server, and on SIGTERM/SIGINT stops accepting, queues running jobs again and
+ * closes cleanly. */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "config.h"
+#include "http.h"
+#include "log.h"
+#include "service.h"
+#include "workers.h"
+
+/* Creates the directory that holds the database file, if missing (one level). */
+static int make_db_dir(const char *db_path)
+{
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", db_path);
+    char *slash = strrchr(dir, '/');
+    if (!slash || slash == dir)
+        return 0;
+    *slash = '\0';
+    if (mkdir(dir, 0750) == 0 || errno == EEXIST)
+        return 0;
+    gp_log("cannot create the data directory %s: %s", dir, strerror(errno));
+    return -1;
+}
+
+/* Writes the bound port to path through a rename, so a reader never sees half of it. */
+static int write_ready_file(const char *path, unsigned port)
+{
+    char tmp[PATH_MAX + 8];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f || fprintf(f, "%u\n", port) < 0 || fclose(f) != 0 || rename(tmp, path) != 0) {
+        gp_log("cannot write the ready file %s: %s", path, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    gp_config cfg;
+    int rc = gp_config_load(&cfg, argc, argv, stdout, stderr);
+    if (rc)
+        return rc > 0 ? 0 : 2;
+
+    /* every thread inherits this mask: the signals are taken by sigwait below only */
+    sigset_t stop_signals;
+    sigemptyset(&stop_signals);
+    sigaddset(&stop_signals, SIGTERM);
+    sigaddset(&stop_signals, SIGINT);
+    pthread_sigmask(SIG_BLOCK, &stop_signals, NULL);
+    signal(SIGPIPE, SIG_IGN); /* a client that hangs up must not kill the daemon */
+
+    gp_service svc;
+    memset(&svc, 0, sizeof svc);
+    svc.cfg = &cfg;
+    svc.started = gp_monotonic_seconds();
+    atomic_init(&svc.queued, 0);
+    atomic_init(&svc.accepting, 1);
+    struct MHD_Daemon *http = NULL;
+    int status = 1, requeued = 0;
+    char why[512];
+    if (make_db_dir(cfg.db_path))
+        goto done;
+    if (gp_store_open(cfg.db_path, &svc.store, &requeued, why, sizeof why)) {
+        gp_log("cannot open the job store: %s", why);
+        goto done;
+    }
+    gp_db *db = gp_store_acquire(svc.store, 1);
+    long counts[GP_JOB_NSTATUS];
+    if (!db || gp_store_count(db, counts)) {
+        gp_store_release(svc.store, db);
+        gp_log("cannot read the job store %s", cfg.db_path);
+        goto done;
+    }
+    gp_store_release(svc.store, db);
+    atomic_store(&svc.queued, counts[GP_JOB_ACCEPTED]);
+    if (!(svc.metrics = gp_metrics_new()) || gp_waiters_start(&svc.waiters) ||
+        gp_pool_start(&svc, &svc.pool)) {
+        gp_log("out of memory starting up");
+        goto done;
+    }
+    unsigned port;
+    if (gp_http_start(&svc, &http, &port))
+        goto done;
+    gp_log("grainpackd %s listening on %s port %u; store %s (%ld jobs waiting, %d of them "
+           "queued again after a stop); %d workers",
+           GP_VERSION, cfg.host, port, cfg.db_path, counts[GP_JOB_ACCEPTED], requeued,
+           cfg.workers);
+    if (cfg.ready_file[0] && write_ready_file(cfg.ready_file, port))
+        goto done;
+
+    int sig = 0;
+    while (sigwait(&stop_signals, &sig) != 0)
+        ;
+    gp_log("received %s: stopping (no new jobs; running jobs are queued again)",
+           sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    status = 0;
+
+done:
+    atomic_store(&svc.accepting, 0);
+    if (http)
+        gp_http_quiesce(http);
+    gp_pool_stop(svc.pool);
+    gp_waiters_stop(svc.waiters);
+    if (http)
+        gp_http_stop(http);
+    gp_pool_free(svc.pool);
+    gp_waiters_free(svc.waiters);
+    gp_metrics_free(svc.metrics);
+    gp_store_close(svc.store);
+    if (status == 0)
+        gp_log("grainpackd stopped cleanly");
+    return status;
+}

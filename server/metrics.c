@@ -1,0 +1,159 @@
+/* metrics.c - Prometheus counters, gauges and stage-duration histograms. */
+#include "metrics.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grainpack/pipeline.h"
+
+/* Bucket bounds in seconds: an iron job packs in about a millisecond, a 10^7-disk job in
+ * minutes, so the buckets span six decades. */
+static const double bucket_bounds[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1,
+                                       0.25,   0.5,   1,      2.5,   5,    10,    30,    60,
+                                       300};
+#define NBUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
+
+static const char *const outcome_names[] = {"successful", "failed", "dismissed", "discarded",
+                                            "requeued"};
+#define NOUTCOMES (sizeof outcome_names / sizeof outcome_names[0])
+
+/* Durations are summed in microseconds so that the sum stays an atomic integer. */
+typedef struct stage_histogram {
+    _Atomic(const char *) name;
+    atomic_ulong buckets[NBUCKETS]; /* not cumulative; summed when rendered */
+    atomic_ulong count;
+    atomic_ullong sum_us;
+} stage_histogram;
+
+struct gp_metrics {
+    atomic_ulong requests[600]; /* by status code */
+    atomic_ulong outcomes[NOUTCOMES];
+    pthread_mutex_t stage_lock; /* taken only to claim a histogram for a new stage name */
+    stage_histogram stages[GP_MAX_STAGES];
+};
+
+gp_metrics *gp_metrics_new(void)
+{
+    gp_metrics *m = calloc(1, sizeof *m);
+    if (m)
+        pthread_mutex_init(&m->stage_lock, NULL);
+    return m;
+}
+
+void gp_metrics_free(gp_metrics *m)
+{
+    if (!m)
+        return;
+    pthread_mutex_destroy(&m->stage_lock);
+    free(m);
+}
+
+void gp_metrics_request(gp_metrics *m, unsigned status)
+{
+    if (status < 600)
+        atomic_fetch_add(&m->requests[status], 1);
+}
+
+void gp_metrics_outcome(gp_metrics *m, const char *outcome)
+{
+    for (size_t i = 0; i < NOUTCOMES; i++)
+        if (strcmp(outcome, outcome_names[i]) == 0)
+            atomic_fetch_add(&m->outcomes[i], 1);
+}
+
+static stage_histogram *stage_slot(gp_metrics *m, const char *stage)
+{
+    for (int i = 0; i < GP_MAX_STAGES; i++) {
+        const char *name = atomic_load(&m->stages[i].name);
+        if (name && strcmp(name, stage) == 0)
+            return &m->stages[i];
+    }
+    stage_histogram *slot = NULL;
+    pthread_mutex_lock(&m->stage_lock);
+    for (int i = 0; i < GP_MAX_STAGES && !slot; i++) {
+        const char *name = atomic_load(&m->stages[i].name);
+        if (!name)
+            atomic_store(&m->stages[i].name, stage);
+        if (!name || strcmp(name, stage) == 0)
+            slot = &m->stages[i];
+    }
+    pthread_mutex_unlock(&m->stage_lock);
+    return slot;
+}
+
+void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds)
+{
+    stage_histogram *h = stage_slot(m, stage);
+    if (!h)
+        return;
+    size_t b = 0;
+    while (b < NBUCKETS && seconds > bucket_bounds[b])
+        b++;
+    if (b < NBUCKETS)
+        atomic_fetch_add(&h->buckets[b], 1);
+    atomic_fetch_add(&h->count, 1);
+    atomic_fetch_add(&h->sum_us, (unsigned long long)(seconds * 1e6 + 0.5));
+}
+
+char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
+{
+    char *text = NULL;
+    FILE *f = open_memstream(&text, len);
+    if (!f)
+        return NULL;
+    fputs("# HELP grainpack_http_requests_total HTTP requests answered, by status code.\n"
+          "# TYPE grainpack_http_requests_total counter\n",
+          f);
+    for (unsigned code = 100; code < 600; code++) {
+        unsigned long n = atomic_load(&m->requests[code]);
+        if (n)
+            fprintf(f, "grainpack_http_requests_total{code=\"%u\"} %lu\n", code, n);
+    }
+    fputs("# HELP grainpack_jobs Jobs in the store, by status.\n# TYPE grainpack_jobs gauge\n", f);
+    for (int s = 0; s < GP_JOB_NSTATUS; s++)
+        fprintf(f, "grainpack_jobs{status=\"%s\"} %ld\n", gp_job_status_name((gp_job_status)s),
+                g->jobs[s]);
+    fprintf(f,
+            "# HELP grainpack_queue_depth Accepted jobs waiting for a worker.\n"
+            "# TYPE grainpack_queue_depth gauge\ngrainpack_queue_depth %ld\n"
+            "# HELP grainpack_workers Worker threads.\n# TYPE grainpack_workers gauge\n"
+            "grainpack_workers %d\n"
+            "# HELP grainpack_workers_busy Workers running a job.\n"
+            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n",
+            g->queue_depth, g->workers, g->workers_busy);
+    fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
+          "# TYPE grainpack_job_runs_total counter\n",
+          f);
+    for (size_t i = 0; i < NOUTCOMES; i++)
+        fprintf(f, "grainpack_job_runs_total{outcome=\"%s\"} %lu\n", outcome_names[i],
+                atomic_load(&m->outcomes[i]));
+    fputs("# HELP grainpack_stage_duration_seconds Wall-clock time of pipeline stages.\n"
+          "# TYPE grainpack_stage_duration_seconds histogram\n",
+          f);
+    for (int i = 0; i < GP_MAX_STAGES; i++) {
+        stage_histogram *h = &m->stages[i];
+        const char *name = atomic_load(&h->name);
+        if (!name)
+            continue;
+        unsigned long cumulative = 0;
+        for (size_t b = 0; b < NBUCKETS; b++) {
+            cumulative += atomic_load(&h->buckets[b]);
+            fprintf(f, "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"%g\"} %lu\n",
+                    name, bucket_bounds[b], cumulative);
+        }
+        unsigned long count = atomic_load(&h->count);
+        fprintf(f,
+                "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"+Inf\"} %lu\n"
+                "grainpack_stage_duration_seconds_sum{stage=\"%s\"} %.6f\n"
+                "grainpack_stage_duration_seconds_count{stage=\"%s\"} %lu\n",
+                name, count, name, (double)atomic_load(&h->sum_us) * 1e-6, name, count);
+    }
+    if (fclose(f) != 0) {
+        free(text);
+        return NULL;
+    }
+    return text;
+}

@@ -1,0 +1,38 @@
+/* metrics.h - counters and histograms the daemon exposes at /metrics, in the Prometheus
+ * text format. Every update is a lock-free atomic add except the first sight of a stage
+ * name, so HTTP threads and workers may update at will. */
+#ifndef GRAINPACKD_METRICS_H
+#define GRAINPACKD_METRICS_H
+
+#include <stddef.h>
+
+#include "store.h"
+
+typedef struct gp_metrics gp_metrics;
+
+/* A new zeroed set of metrics (NULL when out of memory); free with gp_metrics_free. */
+gp_metrics *gp_metrics_new(void);
+void gp_metrics_free(gp_metrics *m);
+
+/* One HTTP request answered with `status`. */
+void gp_metrics_request(gp_metrics *m, unsigned status);
+
+/* How a worker's run of a job ended: "successful", "failed", "dismissed" (canceled by a
+ * DELETE), "discarded" (finished after a DELETE: result dropped) or "requeued". */
+void gp_metrics_outcome(gp_metrics *m, const char *outcome);
+
+/* A pipeline stage took `seconds` (histogram per stage name; names are static strings
+ * from the engine, at most GP_MAX_STAGES of them are tracked). */
+void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds);
+
+/* The state the text needs besides the counters. */
+typedef struct gp_metrics_gauges {
+    long jobs[GP_JOB_NSTATUS]; /* jobs in the store by status */
+    long queue_depth;          /* accepted jobs waiting for a worker */
+    int workers, workers_busy;
+} gp_metrics_gauges;
+
+/* The whole exposition as a malloc'd text (caller frees), NULL when out of memory. */
+char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len);
+
+#endif

@@ -1,0 +1,33 @@
+/* reply.h - what a route answers, independent of the HTTP library: status, media type,
+ * body and the few headers the API uses. http.c turns it into a libmicrohttpd response. */
+#ifndef GRAINPACKD_REPLY_H
+#define GRAINPACKD_REPLY_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+typedef struct gp_reply {
+    unsigned status;
+    const char *content_type; /* static string */
+    char *body;               /* owned (malloc'd), may be NULL for an empty body */
+    size_t len;
+    char location[160];       /* Location header, "" for none */
+    char allow[64];           /* Allow header (405), "" for none */
+    int retry_after;          /* Retry-After seconds (503), 0 for none */
+} gp_reply;
+
+/* Serialises `value` (reference stolen) as the body with the given status and media type.
+ * Returns 0 or GP_ENOMEM (then the reply is a bare 500). */
+int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, json_t *value);
+
+/* Takes ownership of a malloc'd body. */
+void gp_reply_take(gp_reply *reply, unsigned status, const char *content_type, char *body,
+                   size_t len);
+
+/* Copies a static text into a new body. Returns 0 or GP_ENOMEM. */
+int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, const char *text,
+                  size_t len);
+
+void gp_reply_free(gp_reply *reply);
+
+#endif

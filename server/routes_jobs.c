@@ -1,0 +1,248 @@
+/* routes_jobs.c - submitting a job, listing jobs, following one (with the long-poll),
+ * dismissing or deleting it. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grainpack/spec.h"
+#include "jobinfo.h"
+#include "log.h"
+#include "problem.h"
+#include "routes.h"
+#include "workers.h"
+
+#define JSON_TYPE "application/json"
+/* Page size of GET /jobs when no limit is given, and the largest allowed. */
+#define DEFAULT_LIMIT 10
+#define MAX_LIMIT 1000
+/* Seconds a client is told to wait when the queue is full or the daemon is stopping. */
+#define RETRY_AFTER_SECONDS 5
+
+/* Parses an unsigned decimal query parameter in [lo, hi]. Returns 0 (value set, or
+ * left alone when absent) or -1 with a 400 problem in reply. */
+static int query_count(const gp_request *req, const char *name, long long lo, long long hi,
+                       long long *value, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, name);
+    if (!text)
+        return 0;
+    char *end;
+    errno = 0;
+    long long v = strtoll(text, &end, 10);
+    if (errno || end == text || *end || v < lo || v > hi) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "%s must be an integer from %lld to %lld, got '%.40s'", name, lo, hi, text);
+        return -1;
+    }
+    *value = v;
+    return 0;
+}
+
+static void store_unavailable(const gp_request *req, gp_reply *reply)
+{
+    gp_problem(reply, 503, GP_PROBLEM_INTERNAL, req->path,
+               "the job store is not available right now; try again");
+    reply->retry_after = RETRY_AFTER_SECONDS;
+}
+
+static void no_such_job(const gp_request *req, gp_reply *reply)
+{
+    gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_JOB, req->path,
+               "there is no job '%s' (never submitted, or deleted)", req->id);
+}
+
+int gp_route_execute(gp_request *req, gp_reply *reply)
+{
+    gp_service *svc = req->svc;
+    if (strcmp(req->id, GP_PROCESS_ID) != 0) {
+        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, req->path,
+                   "there is no process '%s'; this service offers '" GP_PROCESS_ID "'", req->id);
+        return GP_ROUTE_DONE;
+    }
+    if (!atomic_load(&svc->accepting)) {
+        gp_problem(reply, 503, GP_PROBLEM_SHUTTING_DOWN, req->path,
+                   "the service is shutting down and accepts no new jobs");
+        reply->retry_after = RETRY_AFTER_SECONDS;
+        return GP_ROUTE_DONE;
+    }
+    gp_spec_limits limits = {svc->cfg->max_disks, 0};
+    gp_spec spec;
+    gp_error err;
+    gp_error_clear(&err);
+    if (gp_spec_parse(req->body, req->body_len, &limits, &spec, &err)) {
+        gp_problem_from_spec_error(reply, req->path, &err);
+        return GP_ROUTE_DONE;
+    }
+    /* reserve a queue place first, so that concurrent submissions cannot overshoot */
+    long before = atomic_fetch_add(&svc->queued, 1);
+    if (before >= (long)svc->cfg->max_queued) {
+        atomic_fetch_sub(&svc->queued, 1);
+        gp_spec_free(&spec);
+        gp_problem(reply, 503, GP_PROBLEM_QUEUE_FULL, req->path,
+                   "%ld jobs are waiting, the limit (--max-queued) is %zu; try again later",
+                   before, svc->cfg->max_queued);
+        reply->retry_after = RETRY_AFTER_SECONDS;
+        return GP_ROUTE_DONE;
+    }
+    gp_job job;
+    gp_db *db = gp_store_acquire(svc->store, 1);
+    int rc = db ? gp_store_insert_job(db, req->body, req->body_len, &spec, &job) : GP_SRV_EDB;
+    gp_store_release(svc->store, db);
+    double expected = spec.expected_disks;
+    gp_spec_free(&spec);
+    if (rc) {
+        atomic_fetch_sub(&svc->queued, 1);
+        store_unavailable(req, reply);
+        return GP_ROUTE_DONE;
+    }
+    gp_log("job %s accepted: about %.0f disks expected", job.id, expected);
+    gp_pool_notify(svc->pool);
+    snprintf(reply->location, sizeof reply->location, "/jobs/%s", job.id);
+    gp_reply_json(reply, 201, JSON_TYPE, gp_job_status_info(&job));
+    return GP_ROUTE_DONE;
+}
+
+/* Parses ?status=a,b into a bit mask of gp_job_status. Returns 0 or -1 with a 400. */
+static int status_filter(const gp_request *req, unsigned *mask, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, "status");
+    *mask = 0;
+    if (!text)
+        return 0;
+    char name[32];
+    for (const char *p = text;;) {
+        size_t n = strcspn(p, ",");
+        gp_job_status st;
+        snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), p);
+        if (n >= sizeof name || gp_job_status_parse(name, &st)) {
+            gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                       "status must be a comma-separated list of accepted, running, successful, "
+                       "failed, dismissed; got '%.60s'", text);
+            return -1;
+        }
+        *mask |= 1u << st;
+        if (!p[n])
+            return 0;
+        p += n + 1;
+    }
+}
+
+int gp_route_jobs(gp_request *req, gp_reply *reply)
+{
+    gp_service *svc = req->svc;
+    long long limit = DEFAULT_LIMIT, cursor = 0;
+    unsigned mask;
+    if (query_count(req, "limit", 1, MAX_LIMIT, &limit, reply) ||
+        query_count(req, "cursor", 1, INT64_MAX, &cursor, reply) ||
+        status_filter(req, &mask, reply))
+        return GP_ROUTE_DONE;
+    gp_job *jobs = malloc((size_t)limit * sizeof *jobs);
+    if (!jobs) {
+        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory");
+        return GP_ROUTE_DONE;
+    }
+    size_t n = 0;
+    int more = 0;
+    gp_db *db = gp_store_acquire(svc->store, 1);
+    int rc = db ? gp_store_list_jobs(db, mask, cursor, (size_t)limit, jobs, &n, &more) : GP_SRV_EDB;
+    gp_store_release(svc->store, db);
+    if (rc) {
+        free(jobs);
+        store_unavailable(req, reply);
+        return GP_ROUTE_DONE;
+    }
+    json_t *list = json_array();
+    for (size_t i = 0; list && i < n; i++)
+        json_array_append_new(list, gp_job_status_info(&jobs[i]));
+    /* the links repeat the query so that the next page keeps the filter */
+    const char *status = gp_request_query(req, "status");
+    char self[160], next[200];
+    snprintf(self, sizeof self, "/jobs?limit=%lld%s%.60s", limit, status ? "&status=" : "",
+             status ? status : "");
+    json_t *links = json_pack("[{s:s, s:s, s:s}]", "href", self, "rel", "self", "type", JSON_TYPE);
+    if (more && n > 0 && links) {
+        snprintf(next, sizeof next, "%s&cursor=%lld", self, (long long)jobs[n - 1].seq);
+        json_array_append_new(links,
+                              json_pack("{s:s, s:s, s:s}", "href", next, "rel", "next", "type", JSON_TYPE));
+    }
+    free(jobs);
+    gp_reply_json(reply, 200, JSON_TYPE, json_pack("{s:o, s:o}", "jobs", list, "links", links));
+    return GP_ROUTE_DONE;
+}
+
+/* Reads a job with a connection of its own. */
+static int read_job(gp_service *svc, const char *id, gp_job *job)
+{
+    gp_db *db = gp_store_acquire(svc->store, 1);
+    int rc = db ? gp_store_get_job(db, id, job) : GP_SRV_EDB;
+    gp_store_release(svc->store, db);
+    return rc;
+}
+
+int gp_route_job(gp_request *req, gp_reply *reply)
+{
+    gp_service *svc = req->svc;
+    long long wait = 0;
+    if (query_count(req, "wait", 0, svc->cfg->max_wait, &wait, reply))
+        return GP_ROUTE_DONE;
+    gp_job job;
+    int rc = read_job(svc, req->id, &job);
+    /* the long-poll: register, look again (the job may have finished in between), and
+     * suspend only if it still runs; a worker's wake-up or the deadline resumes us */
+    if (rc == 0 && wait > 0 && !req->resumed && !gp_job_status_final(job.status)) {
+        gp_waiter *w = gp_waiters_add(svc->waiters, req->conn, req->id,
+                                      gp_monotonic_seconds() + (double)wait);
+        if (w) {
+            rc = read_job(svc, req->id, &job);
+            if (rc == 0 && !gp_job_status_final(job.status)) {
+                if (gp_waiters_suspend(svc->waiters, w))
+                    return GP_ROUTE_SUSPENDED;
+                rc = read_job(svc, req->id, &job);
+            } else {
+                gp_waiters_cancel(svc->waiters, w);
+            }
+        }
+    }
+    if (rc == GP_SRV_ENOTFOUND)
+        no_such_job(req, reply);
+    else if (rc)
+        store_unavailable(req, reply);
+    else
+        gp_reply_json(reply, 200, JSON_TYPE, gp_job_status_info(&job));
+    return GP_ROUTE_DONE;
+}
+
+int gp_route_dismiss(gp_request *req, gp_reply *reply)
+{
+    gp_service *svc = req->svc;
+    gp_job_status before = GP_JOB_ACCEPTED;
+    gp_job job;
+    int deleted = 0;
+    memset(&job, 0, sizeof job);
+    gp_db *db = gp_store_acquire(svc->store, 1);
+    int rc = db ? gp_store_dismiss(db, req->id, &before, &deleted, &job) : GP_SRV_EDB;
+    gp_store_release(svc->store, db);
+    if (rc == GP_SRV_ENOTFOUND) {
+        no_such_job(req, reply);
+        return GP_ROUTE_DONE;
+    }
+    if (rc) {
+        store_unavailable(req, reply);
+        return GP_ROUTE_DONE;
+    }
+    if (deleted) {
+        gp_log("job %s deleted with its results (it was %s)", req->id, gp_job_status_name(before));
+        job.status = GP_JOB_DISMISSED;
+        snprintf(job.message, sizeof job.message, "deleted with its results");
+    } else {
+        if (before == GP_JOB_ACCEPTED)
+            atomic_fetch_sub(&svc->queued, 1);
+        else
+            gp_pool_cancel(svc->pool, req->id);
+        gp_log("job %s dismissed (it was %s)", req->id, gp_job_status_name(before));
+        gp_waiters_wake(svc->waiters, req->id);
+    }
+    gp_reply_json(reply, 200, JSON_TYPE, gp_job_status_info(&job));
+    return GP_ROUTE_DONE;
+}

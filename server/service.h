@@ -1,0 +1,26 @@
+/* service.h - the daemon's parts, wired together by main.c and handed to every route and
+ * worker: nothing in the server lives in a global. */
+#ifndef GRAINPACKD_SERVICE_H
+#define GRAINPACKD_SERVICE_H
+
+#include <stdatomic.h>
+
+#include "config.h"
+#include "metrics.h"
+#include "store.h"
+#include "waiters.h"
+
+typedef struct gp_pool gp_pool;
+
+typedef struct gp_service {
+    const gp_config *cfg;
+    gp_store *store;
+    gp_metrics *metrics;
+    gp_waiters *waiters;
+    gp_pool *pool;
+    atomic_long queued;   /* accepted jobs not yet claimed: admission control and metrics */
+    atomic_int accepting; /* 0 once shutdown began: submissions get 503 */
+    double started;       /* monotonic seconds at start, for /health's uptime */
+} gp_service;
+
+#endif

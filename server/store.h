@@ -1,0 +1,131 @@
+/* store.h - the job store on sqlite3: jobs, their results and statistics, in one database
+ * file that stays readable with the sqlite3 shell. WAL mode, writes in BEGIN IMMEDIATE,
+ * a connection per thread (gp_db), schema versioned by PRAGMA user_version.
+ *
+ * Locking: each gp_db is used by one thread at a time (acquire/release); the store's own
+ * mutex only guards its free list of connections. */
+#ifndef GRAINPACKD_STORE_H
+#define GRAINPACKD_STORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/pipeline.h"
+#include "grainpack/spec.h"
+
+/* Service error codes, next to the engine's GP_E... codes (all negative). */
+enum {
+    GP_SRV_ENOTFOUND = -100, /* no such job (or no job to claim) */
+    GP_SRV_ESTATE = -101,    /* the job is not in the state the operation needs */
+    GP_SRV_EDB = -102        /* sqlite failed; the log has its message */
+};
+
+/* The schema version this build migrates to (PRAGMA user_version). */
+#define GP_STORE_SCHEMA_VERSION 1
+
+typedef enum gp_job_status {
+    GP_JOB_ACCEPTED = 0,
+    GP_JOB_RUNNING,
+    GP_JOB_SUCCESSFUL,
+    GP_JOB_FAILED,
+    GP_JOB_DISMISSED,
+    GP_JOB_NSTATUS
+} gp_job_status;
+
+const char *gp_job_status_name(gp_job_status status);
+/* Maps a name to a status; returns 0 or GP_EINVAL. */
+int gp_job_status_parse(const char *name, gp_job_status *out);
+static inline int gp_job_status_final(gp_job_status s)
+{
+    return s == GP_JOB_SUCCESSFUL || s == GP_JOB_FAILED || s == GP_JOB_DISMISSED;
+}
+
+#define GP_JOB_ID_SIZE 37 /* a UUID and its NUL */
+
+/* A job's status as the API shows it. Empty timestamps are not set yet. */
+typedef struct gp_job {
+    int64_t seq; /* submission order, the list cursor */
+    char id[GP_JOB_ID_SIZE];
+    gp_job_status status;
+    char created[32], started[32], finished[32], updated[32];
+    int progress; /* 0-100 */
+    char message[256];
+} gp_job;
+
+typedef struct gp_store gp_store;
+typedef struct gp_db gp_db;
+
+/* Opens (creating if needed) the database at path, migrates it to the current schema and
+ * queues again the jobs a crash left running (their count in *requeued, may be NULL).
+ * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why. The caller owns *out
+ * (gp_store_close). */
+int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size);
+
+/* Closes every connection. All gp_db must have been released. */
+void gp_store_close(gp_store *store);
+
+/* A connection for the calling thread, opened on first need; NULL when sqlite cannot
+ * open one. `durable` connections commit with synchronous=FULL (the HTTP side: a 201 is
+ * only sent for a job on disk); others with NORMAL (workers: a completion lost on power
+ * failure only makes the job run again). Give it back with gp_store_release. */
+gp_db *gp_store_acquire(gp_store *store, int durable);
+void gp_store_release(gp_store *store, gp_db *db);
+
+/* Inserts an accepted job with a new id; the spec text is kept as submitted and its
+ * summary (domain, law, seed...) in columns. Returns 0 with *out filled, or GP_SRV_EDB. */
+int gp_store_insert_job(gp_db *db, const char *spec_text, size_t spec_len, const gp_spec *spec,
+                        gp_job *out);
+
+/* Reads a job's status. Returns 0, GP_SRV_ENOTFOUND or GP_SRV_EDB. */
+int gp_store_get_job(gp_db *db, const char *id, gp_job *out);
+
+/* Lists jobs newest first: those with seq < before (0: from the newest), of the statuses
+ * whose bit (1 << status) is set in status_mask (0: all), at most `limit`. Writes the jobs
+ * into out (room for limit) and their number into *n; *more is 1 when further jobs
+ * match. Returns 0 or GP_SRV_EDB. */
+int gp_store_list_jobs(gp_db *db, unsigned status_mask, int64_t before, size_t limit,
+                       gp_job *out, size_t *n, int *more);
+
+/* Claims the oldest accepted job atomically (UPDATE ... RETURNING): it becomes running.
+ * Returns 0 with the id and a malloc'd copy of its spec text (caller frees), or
+ * GP_SRV_ENOTFOUND when none waits, or GP_SRV_EDB. */
+int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len);
+
+/* Records the progress of a running job (no-op when it is no longer running). */
+int gp_store_progress(gp_db *db, const char *id, int percent, const char *message);
+
+/* Stores a successful job's result (disks as a blob, summary figures as columns, one
+ * statistics row per bin, stage timings) and marks it successful, in one transaction.
+ * Returns 0, GP_SRV_ESTATE when the job is no longer running (dismissed meanwhile:
+ * nothing is written) or GP_SRV_EDB. */
+int gp_store_finish(gp_db *db, const char *id, const gp_result *result);
+
+/* Marks a running job failed with a reason. Returns 0, GP_SRV_ESTATE or GP_SRV_EDB. */
+int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message);
+
+/* Puts a running job back in the queue (daemon shutting down). 0, GP_SRV_ESTATE, EDB. */
+int gp_store_requeue(gp_db *db, const char *id);
+
+/* DELETE /jobs/{id}: an accepted or running job becomes dismissed (*deleted = 0); a
+ * finished one (successful, failed, dismissed) is deleted with its results (*deleted =
+ * 1). *before gets the status the job had. Returns 0, GP_SRV_ENOTFOUND or GP_SRV_EDB. */
+int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *deleted,
+                     gp_job *after);
+
+/* What is needed to render a successful job's result again: the spec text (malloc'd,
+ * caller frees) and the packing with its front diagnostics (free with gp_packing_free).
+ * Returns 0, GP_SRV_ENOTFOUND (no such job or no result) or GP_SRV_EDB/GP_ENOMEM. */
+int gp_store_load_result(gp_db *db, const char *id, char **spec_text, size_t *spec_len,
+                         gp_packing *packing);
+
+/* The stage timings of a job, in the order the stages ran (at most cap; stage names are
+ * copied into names[i], 32 bytes each). Returns the count or a negative code. */
+int gp_store_load_timings(gp_db *db, const char *id, char names[][32], double *seconds, int cap);
+
+/* Counts jobs by status (counts has GP_JOB_NSTATUS entries). Returns 0 or GP_SRV_EDB. */
+int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS]);
+
+/* Whether the database answers a query (for /health; cheap enough to poll). */
+int gp_store_healthy(gp_db *db);
+
+#endif

@@ -1,0 +1,50 @@
+/* store_schema.c - the SQL of each schema migration (see store_schema.h). The tables are
+ * meant to be queried by hand: `sqlite3 grainpack.db "select ..."`. */
+#include "store_schema.h"
+
+static const char migration_1[] =
+    /* One row per job. Summary figures are columns so that past jobs can be compared
+     * with plain SQL; they are NULL until the job succeeds. */
+    "CREATE TABLE jobs ("
+    "  seq INTEGER PRIMARY KEY AUTOINCREMENT," /* submission order; never reused */
+    "  id TEXT NOT NULL UNIQUE,"               /* the jobID (UUID) */
+    "  status TEXT NOT NULL CHECK (status IN"
+    "    ('accepted','running','successful','failed','dismissed')),"
+    "  created TEXT NOT NULL, started TEXT, finished TEXT, updated TEXT NOT NULL," /* RFC 3339 UTC */
+    "  progress INTEGER NOT NULL DEFAULT 0,"
+    "  message TEXT NOT NULL DEFAULT '',"
+    "  claims INTEGER NOT NULL DEFAULT 0," /* times a worker took it: > 1 after a requeue */
+    "  error TEXT,"                        /* failed jobs: the engine's error name */
+    "  spec TEXT NOT NULL,"                /* the request body as submitted */
+    "  domain_width REAL NOT NULL, domain_height REAL NOT NULL,"
+    "  distribution TEXT NOT NULL, joint TEXT NOT NULL, level_band INTEGER NOT NULL,"
+    "  seed INTEGER NOT NULL, expected_disks REAL NOT NULL,"
+    "  count INTEGER, packing_density REAL, grain_fraction REAL,"
+    "  r_min REAL, r_max REAL, r_mean REAL,"
+    "  chi2 REAL, dof INTEGER, p_value REAL, max_abs_z REAL,"
+    "  initial_disks INTEGER, front_attempts INTEGER, front_closures INTEGER,"
+    "  front_frozen INTEGER, front_capped INTEGER, max_level INTEGER);"
+    "CREATE INDEX jobs_by_status ON jobs (status, seq);"
+    /* The disks of a successful job, from which every format is rendered on request:
+     * `count` records of four little-endian float64 (x, y, r, R), 32 bytes per disk. */
+    "CREATE TABLE results ("
+    "  job_id TEXT PRIMARY KEY REFERENCES jobs (id) ON DELETE CASCADE,"
+    "  count INTEGER NOT NULL,"
+    "  disks BLOB NOT NULL);"
+    /* Achieved versus target distribution, one row per bin. */
+    "CREATE TABLE bin_stats ("
+    "  job_id TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
+    "  bin INTEGER NOT NULL,"
+    "  min REAL NOT NULL, max REAL NOT NULL, target REAL NOT NULL, achieved REAL NOT NULL,"
+    "  count INTEGER NOT NULL, z REAL NOT NULL,"
+    "  PRIMARY KEY (job_id, bin)) WITHOUT ROWID;"
+    /* Wall-clock seconds per pipeline stage, in the order they ran. */
+    "CREATE TABLE stage_timings ("
+    "  job_id TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
+    "  position INTEGER NOT NULL,"
+    "  stage TEXT NOT NULL,"
+    "  seconds REAL NOT NULL,"
+    "  PRIMARY KEY (job_id, position)) WITHOUT ROWID;";
+
+const char *const gp_store_migrations[] = {migration_1};
+const size_t gp_store_migration_count = sizeof gp_store_migrations / sizeof gp_store_migrations[0];

@@ -1,0 +1,276 @@
+/* workers.c - worker threads: claim a job, run the pipeline, store what came of it. */
+#include "workers.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "grainpack/pipeline.h"
+#include "grainpack/spec.h"
+#include "log.h"
+
+/* Seconds between two progress writes of one job: often enough for a person watching a
+ * long job, rare enough that progress never competes with submissions for the write lock. */
+#define PROGRESS_INTERVAL 0.25
+/* An idle worker looks at the store this often even when nobody notified it (jobs queued
+ * by a previous run of the daemon, or a notification that another worker consumed). */
+#define IDLE_RECHECK_SECONDS 1
+
+/* Values of a worker's cancel flag. */
+enum { CANCEL_NONE = 0, CANCEL_DISMISSED = 1, CANCEL_SHUTDOWN = 2 };
+
+typedef struct worker {
+    gp_pool *pool;
+    pthread_t thread;
+    gp_cancel_flag cancel;
+    char job_id[GP_JOB_ID_SIZE]; /* the job it runs, "" when idle; guarded by pool->lock */
+    gp_db *db;                   /* its own connection, for the thread's lifetime */
+    double last_write;           /* progress throttling */
+    int last_percent;
+} worker;
+
+struct gp_pool {
+    gp_service *svc;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    int stopping;
+    unsigned pending; /* notifications not yet taken by an idle worker */
+    atomic_int busy;
+    int n;
+    worker *workers;
+};
+
+static void report_progress(void *ctx, const char *stage, double fraction)
+{
+    worker *w = ctx;
+    int percent = (int)(fraction * 100.0);
+    percent = percent < 0 ? 0 : (percent > 99 ? 99 : percent); /* 100 means stored */
+    if (percent <= w->last_percent)
+        return;
+    double now = gp_monotonic_seconds();
+    if (now - w->last_write < PROGRESS_INTERVAL)
+        return;
+    char message[64];
+    snprintf(message, sizeof message, "running: %s %d%%", stage, percent);
+    if (gp_store_progress(w->db, w->job_id, percent, message) == 0) {
+        w->last_percent = percent;
+        w->last_write = now;
+    }
+}
+
+/* Publishes or clears the job a worker runs (under the pool lock, so that a cancel
+ * either finds it or comes after it is done). */
+static void set_current(worker *w, const char *id)
+{
+    gp_pool *pool = w->pool;
+    pthread_mutex_lock(&pool->lock);
+    atomic_store(&w->cancel, pool->stopping ? CANCEL_SHUTDOWN : CANCEL_NONE);
+    snprintf(w->job_id, sizeof w->job_id, "%s", id);
+    pthread_mutex_unlock(&pool->lock);
+}
+
+/* Records how a run ended, in the store, the metrics and the log. */
+static void conclude(worker *w, const char *id, int rc, const gp_result *result,
+                     const gp_error *err)
+{
+    gp_service *svc = w->pool->svc;
+    int flag = atomic_load(&w->cancel);
+    if (rc == 0) {
+        for (int i = 0; i < result->ntimings; i++)
+            gp_metrics_stage(svc->metrics, result->timings[i].stage, result->timings[i].seconds);
+        int st = gp_store_finish(w->db, id, result);
+        if (st == 0) {
+            gp_metrics_outcome(svc->metrics, "successful");
+            gp_log("job %s successful: %zu disks, packing density %.4f, %.3f s", id,
+                   result->stats.count, result->stats.packing_density,
+                   gp_result_stage_seconds(result, "pack"));
+        } else if (st == GP_SRV_ESTATE) {
+            gp_metrics_outcome(svc->metrics, "discarded");
+            gp_log("job %s finished after it was dismissed: result discarded", id);
+        } else {
+            gp_store_fail(w->db, id, "internal error", "the result could not be stored");
+            gp_metrics_outcome(svc->metrics, "failed");
+            gp_log("job %s failed: the result could not be stored", id);
+        }
+    } else if (rc == GP_ECANCELED && flag == CANCEL_SHUTDOWN) {
+        if (gp_store_requeue(w->db, id) == 0)
+            atomic_fetch_add(&svc->queued, 1);
+        gp_metrics_outcome(svc->metrics, "requeued");
+        gp_log("job %s accepted: queued again, the daemon is stopping", id);
+    } else if (rc == GP_ECANCELED) {
+        gp_metrics_outcome(svc->metrics, "dismissed");
+        gp_log("job %s dismissed: worker stopped", id);
+    } else {
+        int st = gp_store_fail(w->db, id, gp_strerror(rc), err->message);
+        gp_metrics_outcome(svc->metrics, "failed");
+        gp_log("job %s failed: %s%s", id, err->message,
+               st == GP_SRV_ESTATE ? " (it had been dismissed)" : "");
+    }
+    gp_waiters_wake(svc->waiters, id);
+}
+
+static void run_job(worker *w, const char *id, const char *spec_text, size_t spec_len)
+{
+    gp_service *svc = w->pool->svc;
+    set_current(w, id);
+    atomic_fetch_sub(&svc->queued, 1);
+    atomic_fetch_add(&w->pool->busy, 1);
+    gp_log("job %s running", id);
+    w->last_percent = 0;
+    w->last_write = gp_monotonic_seconds();
+
+    /* the stored spec was valid when accepted; it is parsed again without the caps, which
+     * may have been lowered since, so that an accepted job always runs */
+    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+    gp_spec spec;
+    gp_result result;
+    gp_error err;
+    gp_error_clear(&err);
+    memset(&result, 0, sizeof result);
+    int rc = gp_spec_parse(spec_text, spec_len, &unlimited, &spec, &err);
+    if (rc == 0) {
+        gp_progress progress = {report_progress, w, &w->cancel};
+        rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
+    }
+    conclude(w, id, rc, &result, &err);
+    gp_result_free(&result);
+    gp_spec_free(&spec);
+    atomic_fetch_sub(&w->pool->busy, 1);
+    set_current(w, "");
+}
+
+/* Waits for a notification, a stop or the recheck interval. Returns 0 when stopping. */
+static int wait_for_work(gp_pool *pool)
+{
+    pthread_mutex_lock(&pool->lock);
+    if (!pool->stopping && pool->pending == 0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_sec += IDLE_RECHECK_SECONDS;
+        pthread_cond_timedwait(&pool->wake, &pool->lock, &ts);
+    }
+    if (pool->pending > 0)
+        pool->pending--;
+    int go_on = !pool->stopping;
+    pthread_mutex_unlock(&pool->lock);
+    return go_on;
+}
+
+static void *worker_main(void *arg)
+{
+    worker *w = arg;
+    gp_pool *pool = w->pool;
+    for (;;) {
+        pthread_mutex_lock(&pool->lock);
+        int stopping = pool->stopping;
+        pthread_mutex_unlock(&pool->lock);
+        if (stopping)
+            break;
+        if (!w->db && !(w->db = gp_store_acquire(pool->svc->store, 0))) {
+            if (!wait_for_work(pool)) /* cannot open the database now: try again later */
+                break;
+            continue;
+        }
+        char id[GP_JOB_ID_SIZE], *spec_text;
+        size_t spec_len;
+        int rc = gp_store_claim(w->db, id, &spec_text, &spec_len);
+        if (rc == 0) {
+            run_job(w, id, spec_text, spec_len);
+            free(spec_text);
+            continue; /* more may be waiting */
+        }
+        if (rc == GP_ENOMEM)
+            gp_log("worker: out of memory claiming a job");
+        if (!wait_for_work(pool))
+            break;
+    }
+    return NULL;
+}
+
+int gp_pool_start(gp_service *svc, gp_pool **out)
+{
+    gp_pool *pool = calloc(1, sizeof *pool);
+    int n = svc->cfg->workers;
+    if (!pool || !(pool->workers = calloc((size_t)n, sizeof *pool->workers))) {
+        free(pool);
+        return GP_ENOMEM;
+    }
+    pool->svc = svc;
+    pthread_mutex_init(&pool->lock, NULL);
+    pthread_cond_init(&pool->wake, NULL);
+    for (int i = 0; i < n; i++) {
+        worker *w = &pool->workers[i];
+        w->pool = pool;
+        atomic_init(&w->cancel, CANCEL_NONE);
+        if (pthread_create(&w->thread, NULL, worker_main, w)) {
+            pool->n = i;
+            gp_pool_stop(pool);
+            gp_pool_free(pool);
+            return GP_ENOMEM;
+        }
+        pool->n = i + 1;
+    }
+    *out = pool;
+    return 0;
+}
+
+void gp_pool_notify(gp_pool *pool)
+{
+    pthread_mutex_lock(&pool->lock);
+    pool->pending++;
+    pthread_cond_signal(&pool->wake);
+    pthread_mutex_unlock(&pool->lock);
+}
+
+int gp_pool_cancel(gp_pool *pool, const char *job_id)
+{
+    int found = 0;
+    pthread_mutex_lock(&pool->lock);
+    for (int i = 0; i < pool->n; i++) {
+        worker *w = &pool->workers[i];
+        if (strcmp(w->job_id, job_id) == 0) {
+            atomic_store(&w->cancel, CANCEL_DISMISSED);
+            found = 1;
+        }
+    }
+    pthread_mutex_unlock(&pool->lock);
+    return found;
+}
+
+int gp_pool_busy(gp_pool *pool)
+{
+    return atomic_load(&pool->busy);
+}
+
+void gp_pool_stop(gp_pool *pool)
+{
+    if (!pool)
+        return;
+    pthread_mutex_lock(&pool->lock);
+    pool->stopping = 1;
+    for (int i = 0; i < pool->n; i++)
+        if (pool->workers[i].job_id[0])
+            atomic_store(&pool->workers[i].cancel, CANCEL_SHUTDOWN);
+    pthread_cond_broadcast(&pool->wake);
+    pthread_mutex_unlock(&pool->lock);
+    for (int i = 0; i < pool->n; i++) {
+        pthread_join(pool->workers[i].thread, NULL);
+        gp_store_release(pool->svc->store, pool->workers[i].db);
+        pool->workers[i].db = NULL;
+    }
+    pthread_mutex_lock(&pool->lock);
+    pool->n = 0;
+    pthread_mutex_unlock(&pool->lock);
+}
+
+void gp_pool_free(gp_pool *pool)
+{
+    if (!pool)
+        return;
+    pthread_cond_destroy(&pool->wake);
+    pthread_mutex_destroy(&pool->lock);
+    free(pool->workers);
+    free(pool);
+}
