@@ -18,6 +18,9 @@
 #define CONNECTION_LIMIT 2048
 /* Seconds an idle connection is kept; longer than the longest long-poll. */
 #define IDLE_TIMEOUT_MARGIN 60
+/* A body without Content-Length that passes the cap is read on (and dropped) up to this
+ * many times the cap, so that the client still gets its 413; beyond, it is cut off. */
+#define DISCARD_FACTOR 16
 /* How long a browser may cache a CORS preflight answer. */
 #define CORS_MAX_AGE "600"
 
@@ -53,7 +56,8 @@ typedef struct request_state {
     char id[ID_MAX + 1];
     char *body;
     size_t len, cap;
-    int too_large;   /* the body passed the cap: answered 413 */
+    int too_large;   /* the body passed the cap: it is dropped, 413 answers */
+    size_t discarded;
     int answered;    /* a response was queued */
     int suspended;   /* a long-poll is waiting */
     gp_waiter *waiter;
@@ -213,6 +217,11 @@ static int precheck(gp_service *svc, struct MHD_Connection *conn, const char *ur
     }
     if (!is_post)
         return 0;
+    if (strcmp(st->id, GP_PROCESS_ID) != 0) { /* before the body: it would not be used */
+        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, url,
+                   "there is no process '%s'; this service offers '" GP_PROCESS_ID "'", st->id);
+        return 1;
+    }
     const char *type = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Content-Type");
     if (!is_json_type(type)) {
         gp_problem(reply, 415, GP_PROBLEM_UNSUPPORTED_MEDIA_TYPE, url,
@@ -273,18 +282,24 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         return MHD_YES; /* the body (if any) comes in the next calls */
     }
     if (st->answered)
-        return MHD_YES; /* rest of a body that was refused: discard */
-    if (*upload_size) {
-        if (gather(svc, st, upload_data, *upload_size)) {
-            st->too_large = 1;
-            gp_problem(&reply, 413, GP_PROBLEM_BODY_TOO_LARGE, url,
-                       "the body is larger than the limit of %zu bytes (--max-body)",
-                       svc->cfg->max_body);
-            *upload_size = 0;
-            return respond(svc, conn, st, &reply, 0);
-        }
-        *upload_size = 0;
         return MHD_YES;
+    if (*upload_size) {
+        /* past the cap the rest is read and dropped, and 413 answered once it is all in:
+         * libmicrohttpd cannot answer in the middle of a chunked upload. A client that
+         * keeps sending far past the cap is cut off. */
+        size_t size = *upload_size;
+        *upload_size = 0;
+        if (!st->too_large && gather(svc, st, upload_data, size))
+            st->too_large = 1;
+        if (st->too_large && (st->discarded += size) > DISCARD_FACTOR * svc->cfg->max_body)
+            return MHD_NO;
+        return MHD_YES;
+    }
+    if (st->too_large) {
+        gp_problem(&reply, 413, GP_PROBLEM_BODY_TOO_LARGE, url,
+                   "the body is larger than the limit of %zu bytes (--max-body)",
+                   svc->cfg->max_body);
+        return respond(svc, conn, st, &reply, 0);
     }
     const route *rt = st->route;
     int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;

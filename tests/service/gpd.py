@@ -1,0 +1,357 @@
+"""gpd.py - what the service tests share: the real grainpackd started on a free loopback
+port with a real sqlite file in a temporary directory, a plain HTTP client, the checks
+that a response matches its schema in openapi.yaml, and a few assertions.
+
+Only Debian's python3 with python3-yaml and python3-jsonschema (see .ci/setup)."""
+
+import http.client
+import json
+import os
+import re
+import signal
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+
+import jsonschema
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+EXAMPLES = os.path.join(ROOT, "examples")
+
+# How long a test waits for something that must happen (a daemon to start, a job to
+# finish). These bound a broken run; no assertion depends on them.
+STARTUP_LIMIT = 60.0
+JOB_LIMIT = 300.0
+
+# Contact tolerance of the engine (include/grainpack/disk.h, GP_CONTACT_RTOL).
+CONTACT_RTOL = 1e-9
+
+
+class Checks:
+    """Counts failed checks; a test goes on after a failure so that one run shows all."""
+
+    def __init__(self, name):
+        self.name = name
+        self.failures = 0
+
+    def check(self, cond, what):
+        if not cond:
+            self.failures += 1
+            print(f"FAIL {self.name}: {what}", file=sys.stderr, flush=True)
+        return bool(cond)
+
+    def done(self):
+        if self.failures:
+            print(f"{self.failures} check(s) failed in {self.name}", file=sys.stderr)
+            return 1
+        print(f"ok   {self.name}")
+        return 0
+
+
+class Response:
+    def __init__(self, status, headers, body):
+        self.status = status
+        self.headers = {k.lower(): v for k, v in headers}
+        self.body = body
+
+    @property
+    def content_type(self):
+        return self.headers.get("content-type", "").split(";")[0].strip()
+
+    def json(self):
+        return json.loads(self.body)
+
+    def __repr__(self):
+        return f"<{self.status} {self.content_type} {self.body[:300]!r}>"
+
+
+class Client:
+    """One keep-alive HTTP/1.1 connection to the daemon (one per thread)."""
+
+    def __init__(self, port, timeout=120):
+        self.port = port
+        self.timeout = timeout
+        self.conn = None
+
+    def request(self, method, path, body=None, headers=None, chunked=False):
+        headers = dict(headers or {})
+        for attempt in range(2):
+            reused = self.conn is not None
+            if self.conn is None:
+                self.conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=self.timeout)
+            try:
+                if chunked:
+                    # chunks without a length up front; with chunked="partial" the last
+                    # chunk is never sent, so that the answer must come before the end
+                    self.conn.putrequest(method, path)
+                    for k, v in headers.items():
+                        self.conn.putheader(k, v)
+                    self.conn.putheader("Transfer-Encoding", "chunked")
+                    self.conn.endheaders()
+                    for i in range(0, len(body), 1024):
+                        piece = body[i:i + 1024]
+                        self.conn.send(b"%x\r\n%s\r\n" % (len(piece), piece))
+                    if chunked != "partial":
+                        self.conn.send(b"0\r\n\r\n")
+                else:
+                    self.conn.request(method, path, body=body, headers=headers)
+                r = self.conn.getresponse()
+                data = r.read()
+                resp = Response(r.status, r.getheaders(), data)
+                if resp.headers.get("connection", "").lower() == "close":
+                    self.close()
+                return resp
+            except (ConnectionError, http.client.RemoteDisconnected, BrokenPipeError):
+                # a kept-alive connection the daemon closed meanwhile: once more on a new
+                # one (never for a fresh connection, so a POST is never sent twice)
+                self.close()
+                if attempt or not reused:
+                    raise
+        raise AssertionError("unreachable")
+
+    def close(self):
+        if self.conn is not None:
+            self.conn.close()
+            self.conn = None
+
+    def get(self, path, headers=None):
+        return self.request("GET", path, headers=headers)
+
+    def post_json(self, path, body, content_type="application/json"):
+        data = body if isinstance(body, bytes) else json.dumps(body).encode()
+        headers = {"Content-Type": content_type} if content_type else {}
+        return self.request("POST", path, body=data, headers=headers)
+
+    def submit(self, spec):
+        return self.post_json("/processes/pack2d/execution", spec)
+
+    def wait_final(self, job_id, limit=JOB_LIMIT):
+        """Long-polls GET /jobs/{id}?wait=.. until the job is finished; its statusInfo."""
+        deadline = time.monotonic() + limit
+        while True:
+            r = self.get(f"/jobs/{job_id}?wait=30")
+            if r.status != 200:
+                raise AssertionError(f"GET /jobs/{job_id}: {r}")
+            info = r.json()
+            if info["status"] in ("successful", "failed", "dismissed"):
+                return info
+            if time.monotonic() > deadline:
+                raise AssertionError(f"job {job_id} not finished after {limit} s: {info}")
+
+    def wait_status(self, job_id, statuses, limit=JOB_LIMIT):
+        """Polls until the job's status is one of `statuses` (for running, which has no
+        long-poll); returns its statusInfo."""
+        deadline = time.monotonic() + limit
+        while True:
+            info = self.get(f"/jobs/{job_id}").json()
+            if info["status"] in statuses:
+                return info
+            if time.monotonic() > deadline:
+                raise AssertionError(f"job {job_id} never reached {statuses}: {info}")
+            time.sleep(0.02)
+
+
+class Daemon:
+    """grainpackd in a temporary data directory, on a port it picks itself."""
+
+    def __init__(self, binary, *args, data_dir=None, env=None):
+        self.binary = binary
+        self.args = list(args)
+        self.own_dir = data_dir is None
+        self.dir = data_dir or tempfile.mkdtemp(prefix="grainpackd-test-")
+        self.db_path = os.path.join(self.dir, "grainpack.db")
+        self.env = dict(os.environ, **(env or {}))
+        self.proc = None
+        self.port = None
+        self.log_path = None
+        self.runs = 0
+
+    def start(self):
+        ready = os.path.join(self.dir, "ready")
+        if os.path.exists(ready):
+            os.unlink(ready)
+        self.runs += 1
+        self.log_path = os.path.join(self.dir, f"daemon-{self.runs}.log")
+        log = open(self.log_path, "w")
+        self.proc = subprocess.Popen(
+            [self.binary, "--port", "0", "--data-dir", self.dir, "--ready-file", ready] + self.args,
+            stdout=log, stderr=log, env=self.env)
+        log.close()
+        deadline = time.monotonic() + STARTUP_LIMIT
+        while not os.path.exists(ready):
+            if self.proc.poll() is not None:
+                raise AssertionError(f"grainpackd exited with {self.proc.returncode}:\n{self.log()}")
+            if time.monotonic() > deadline:
+                raise AssertionError(f"grainpackd did not start:\n{self.log()}")
+            time.sleep(0.01)
+        self.port = int(open(ready).read())
+        return self
+
+    def client(self):
+        return Client(self.port)
+
+    def log(self):
+        try:
+            return open(self.log_path).read()
+        except OSError:
+            return ""
+
+    def stop(self):
+        """SIGTERM; returns the exit status (0 for a clean stop, and under AddressSanitizer
+        also no leak)."""
+        if self.proc is None:
+            return None
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            rc = self.proc.wait(timeout=STARTUP_LIMIT)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            rc = self.proc.wait()
+        self.proc = None
+        return rc
+
+    def kill(self):
+        self.proc.send_signal(signal.SIGKILL)
+        self.proc.wait()
+        self.proc = None
+
+    def db(self):
+        """A read-only connection to the daemon's database file."""
+        return sqlite3.connect(f"file:{self.db_path}?mode=ro", uri=True, timeout=30)
+
+    def cleanup(self):
+        if self.proc is not None:
+            self.kill()
+        if self.own_dir:
+            for name in os.listdir(self.dir):
+                os.unlink(os.path.join(self.dir, name))
+            os.rmdir(self.dir)
+
+
+class OpenAPI:
+    """The responses of openapi.yaml, to check real responses against."""
+
+    def __init__(self, path=os.path.join(ROOT, "openapi.yaml")):
+        with open(path) as f:
+            self.doc = yaml.safe_load(f)
+        self.resolver = jsonschema.RefResolver(base_uri="", referrer=self.doc)
+
+    def _deref(self, node):
+        while isinstance(node, dict) and "$ref" in node:
+            node = self.resolver.resolve(node["$ref"])[1]
+        return node
+
+    def validate(self, schema, instance):
+        """The list of error messages of instance against a schema of the document."""
+        cls = jsonschema.Draft202012Validator
+        validator = cls(schema, resolver=self.resolver, format_checker=cls.FORMAT_CHECKER)
+        return [f"{'/'.join(map(str, e.absolute_path))}: {e.message}"
+                for e in validator.iter_errors(instance)]
+
+    def schema(self, name):
+        return self.doc["components"]["schemas"][name]
+
+    def check(self, checks, method, template, resp):
+        """Checks that resp is documented for (method, template) and its body matches the
+        documented schema; returns whether it did."""
+        what = f"{method} {template} -> {resp.status}"
+        op = self.doc["paths"].get(template, {}).get(method.lower())
+        if not checks.check(op is not None, f"{what}: not in openapi.yaml"):
+            return False
+        documented = op["responses"].get(str(resp.status))
+        if not checks.check(documented is not None, f"{what}: status not documented; {resp}"):
+            return False
+        documented = self._deref(documented)
+        ok = True
+        for header in documented.get("headers", {}):
+            ok &= checks.check(header.lower() in resp.headers, f"{what}: no {header} header")
+        content = documented.get("content", {})
+        media = content.get(resp.content_type)
+        if not checks.check(media is not None,
+                            f"{what}: content type {resp.content_type!r} not documented"):
+            return False
+        schema = media.get("schema", {})
+        if resp.content_type.endswith("json"):
+            try:
+                body = resp.json()
+            except ValueError as e:
+                return checks.check(False, f"{what}: body is not JSON: {e}")
+        else:
+            body = resp.body.decode("utf-8", "replace")
+        errors = self.validate(schema, body)
+        return checks.check(not errors, f"{what}: body does not match its schema: {errors[:3]}") and ok
+
+
+RFC3339 = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?Z$")
+
+
+def load_example(name):
+    with open(os.path.join(EXAMPLES, name + ".json")) as f:
+        return json.load(f)
+
+
+def small_spec(seed=1, side=30):
+    """A job that packs in milliseconds even under AddressSanitizer."""
+    return {"inputs": {"domain": {"width": side, "height": side},
+                       "distribution": {"kind": "constant", "radius": 0.9},
+                       "joint": {"law": "constant", "value": 0.1}, "seed": seed}}
+
+
+def big_spec(side=3000):
+    """A job that runs for seconds: ~2.6 million disks for the default side."""
+    return {"inputs": {"domain": {"width": side, "height": side},
+                       "distribution": {"kind": "constant", "radius": 1.0}}}
+
+
+def parse_csv(text):
+    lines = text.strip().split("\n")
+    return lines[0], [tuple(float(v) for v in line.split(",")) for line in lines[1:]]
+
+
+def find_overlaps(disks, limit=10):
+    """Pairs of disks (x, y, r, R) whose packing disks overlap beyond the engine's
+    tolerance, found through a bucket grid."""
+    if not disks:
+        return []
+    cell = 2 * max(d[3] for d in disks)
+    grid = {}
+    for i, d in enumerate(disks):
+        grid.setdefault((int(d[0] // cell), int(d[1] // cell)), []).append(i)
+    bad = []
+    for i, a in enumerate(disks):
+        cx, cy = int(a[0] // cell), int(a[1] // cell)
+        for gx in (cx - 1, cx, cx + 1):
+            for gy in (cy - 1, cy, cy + 1):
+                for j in grid.get((gx, gy), ()):
+                    if j <= i:
+                        continue
+                    b = disks[j]
+                    reach = (a[3] + b[3]) * (1 - CONTACT_RTOL)
+                    if (a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 < reach * reach:
+                        bad.append((i, j))
+                        if len(bad) >= limit:
+                            return bad
+    return bad
+
+
+def metric(text, name, labels=""):
+    """The value of a Prometheus sample, or None."""
+    key = f"{name}{{{labels}}}" if labels else name
+    for line in text.splitlines():
+        if line.startswith(key + " "):
+            return float(line.split()[-1])
+    return None
+
+
+def main(test):
+    """Runs test(checks, *argv[1:]) and exits with its status."""
+    name = os.path.splitext(os.path.basename(sys.argv[0]))[0]
+    checks = Checks(name)
+    try:
+        test(checks, *sys.argv[1:])
+    except AssertionError as e:
+        checks.check(False, str(e))
+    sys.exit(checks.done())
