@@ -1,11 +1,17 @@
 /* workers.c - worker threads: claim a job, run the pipeline, store what came of it. */
+/* SCHED_BATCH (Linux) needs _GNU_SOURCE; the rest of the project keeps _DEFAULT_SOURCE. */
+#define _GNU_SOURCE
 #include "workers.h"
 
 #include <pthread.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
@@ -17,6 +23,11 @@
 /* An idle worker looks at the store this often even when nobody notified it (jobs queued
  * by a previous run of the daemon, or a notification that another worker consumed). */
 #define IDLE_RECHECK_SECONDS 1
+
+/* Niceness of the worker threads: packing yields the processors to the HTTP threads, so
+ * that status requests stay fast while every worker is busy (on Linux, nice is per
+ * thread). Workers still take all the time the HTTP side leaves. */
+#define WORKER_NICE 19
 
 /* Values of a worker's cancel flag. */
 enum { CANCEL_NONE = 0, CANCEL_DISMISSED = 1, CANCEL_SHUTDOWN = 2 };
@@ -162,6 +173,11 @@ static void *worker_main(void *arg)
 {
     worker *w = arg;
     gp_pool *pool = w->pool;
+    /* SCHED_BATCH: a woken HTTP thread preempts a packing worker at once */
+    struct sched_param batch = {0};
+    if (pthread_setschedparam(pthread_self(), SCHED_BATCH, &batch) != 0 ||
+        setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), WORKER_NICE) != 0)
+        gp_log("worker: cannot lower its priority; requests may wait behind packing");
     for (;;) {
         pthread_mutex_lock(&pool->lock);
         int stopping = pool->stopping;
