@@ -218,8 +218,7 @@ static int precheck(gp_service *svc, struct MHD_Connection *conn, const char *ur
     if (!is_post)
         return 0;
     if (strcmp(st->id, GP_PROCESS_ID) != 0) { /* before the body: it would not be used */
-        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, url,
-                   "there is no process '%s'; this service offers '" GP_PROCESS_ID "'", st->id);
+        gp_problem_no_such_process(reply, url, st->id);
         return 1;
     }
     const char *type = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Content-Type");

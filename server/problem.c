@@ -46,6 +46,25 @@ void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *
     build(reply, status, type, instance, detail, NULL, NULL);
 }
 
+void gp_problem_no_such_job(gp_reply *reply, const char *instance, const char *id)
+{
+    gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_JOB, instance,
+               "there is no job '%s' (never submitted, or deleted)", id);
+}
+
+void gp_problem_no_such_process(gp_reply *reply, const char *instance, const char *id)
+{
+    gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, instance,
+               "there is no process '%s'; this service offers 'pack2d'", id);
+}
+
+void gp_problem_store_unavailable(gp_reply *reply, const char *instance)
+{
+    gp_problem(reply, 503, GP_PROBLEM_INTERNAL, instance,
+               "the job store is not available right now; try again");
+    reply->retry_after = GP_RETRY_AFTER_SECONDS;
+}
+
 void gp_problem_from_spec_error(gp_reply *reply, const char *instance, const gp_error *err)
 {
     char detail[768];

@@ -38,6 +38,15 @@ void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *
 #endif
     ;
 
+/* The answers several routes share: no such job (404), no such process (404), and the
+ * store not answering (503 with Retry-After). */
+void gp_problem_no_such_job(gp_reply *reply, const char *instance, const char *id);
+void gp_problem_no_such_process(gp_reply *reply, const char *instance, const char *id);
+void gp_problem_store_unavailable(gp_reply *reply, const char *instance);
+
+/* Seconds a client is told to wait by a 503. */
+#define GP_RETRY_AFTER_SECONDS 5
+
 /* The problem for a spec the engine refused: 400 for GP_EPARSE, 422 for GP_EINVAL and
  * GP_ETOOBIG, with the extension members `pointer` (the JSON pointer of the field in the
  * submitted document) and `expected` (the validator's message), both repeated in

@@ -16,8 +16,6 @@
 /* Page size of GET /jobs when no limit is given, and the largest allowed. */
 #define DEFAULT_LIMIT 10
 #define MAX_LIMIT 1000
-/* Seconds a client is told to wait when the queue is full or the daemon is stopping. */
-#define RETRY_AFTER_SECONDS 5
 
 /* Parses an unsigned decimal query parameter in [lo, hi]. Returns 0 (value set, or
  * left alone when absent) or -1 with a 400 problem in reply. */
@@ -39,31 +37,17 @@ static int query_count(const gp_request *req, const char *name, long long lo, lo
     return 0;
 }
 
-static void store_unavailable(const gp_request *req, gp_reply *reply)
-{
-    gp_problem(reply, 503, GP_PROBLEM_INTERNAL, req->path,
-               "the job store is not available right now; try again");
-    reply->retry_after = RETRY_AFTER_SECONDS;
-}
-
-static void no_such_job(const gp_request *req, gp_reply *reply)
-{
-    gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_JOB, req->path,
-               "there is no job '%s' (never submitted, or deleted)", req->id);
-}
-
 int gp_route_execute(gp_request *req, gp_reply *reply)
 {
     gp_service *svc = req->svc;
     if (strcmp(req->id, GP_PROCESS_ID) != 0) {
-        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, req->path,
-                   "there is no process '%s'; this service offers '" GP_PROCESS_ID "'", req->id);
+        gp_problem_no_such_process(reply, req->path, req->id);
         return GP_ROUTE_DONE;
     }
     if (!atomic_load(&svc->accepting)) {
         gp_problem(reply, 503, GP_PROBLEM_SHUTTING_DOWN, req->path,
                    "the service is shutting down and accepts no new jobs");
-        reply->retry_after = RETRY_AFTER_SECONDS;
+        reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
     gp_spec_limits limits = {svc->cfg->max_disks, 0};
@@ -82,7 +66,7 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         gp_problem(reply, 503, GP_PROBLEM_QUEUE_FULL, req->path,
                    "%ld jobs are waiting, the limit (--max-queued) is %zu; try again later",
                    before, svc->cfg->max_queued);
-        reply->retry_after = RETRY_AFTER_SECONDS;
+        reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
     gp_job job;
@@ -93,7 +77,7 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
     gp_spec_free(&spec);
     if (rc) {
         atomic_fetch_sub(&svc->queued, 1);
-        store_unavailable(req, reply);
+        gp_problem_store_unavailable(reply, req->path);
         return GP_ROUTE_DONE;
     }
     gp_log("job %s accepted: about %.0f disks expected", job.id, expected);
@@ -149,7 +133,7 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
     gp_store_release(svc->store, db);
     if (rc) {
         free(jobs);
-        store_unavailable(req, reply);
+        gp_problem_store_unavailable(reply, req->path);
         return GP_ROUTE_DONE;
     }
     json_t *list = json_array();
@@ -205,9 +189,9 @@ int gp_route_job(gp_request *req, gp_reply *reply)
         }
     }
     if (rc == GP_SRV_ENOTFOUND)
-        no_such_job(req, reply);
+        gp_problem_no_such_job(reply, req->path, req->id);
     else if (rc)
-        store_unavailable(req, reply);
+        gp_problem_store_unavailable(reply, req->path);
     else
         gp_reply_json(reply, 200, JSON_TYPE, gp_job_status_info(&job));
     return GP_ROUTE_DONE;
@@ -224,11 +208,11 @@ int gp_route_dismiss(gp_request *req, gp_reply *reply)
     int rc = db ? gp_store_dismiss(db, req->id, &before, &deleted, &job) : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     if (rc == GP_SRV_ENOTFOUND) {
-        no_such_job(req, reply);
+        gp_problem_no_such_job(reply, req->path, req->id);
         return GP_ROUTE_DONE;
     }
     if (rc) {
-        store_unavailable(req, reply);
+        gp_problem_store_unavailable(reply, req->path);
         return GP_ROUTE_DONE;
     }
     if (deleted) {

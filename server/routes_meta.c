@@ -73,8 +73,7 @@ int gp_route_processes(gp_request *req, gp_reply *reply)
 int gp_route_process(gp_request *req, gp_reply *reply)
 {
     if (strcmp(req->id, GP_PROCESS_ID) != 0) {
-        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, req->path,
-                   "there is no process '%s'; this service offers '" GP_PROCESS_ID "'", req->id);
+        gp_problem_no_such_process(reply, req->path, req->id);
         return GP_ROUTE_DONE;
     }
     gp_reply_json(reply, 200, JSON_TYPE, process_description());
@@ -96,7 +95,7 @@ int gp_route_health(gp_request *req, gp_reply *reply)
                              gp_monotonic_seconds() - svc->started, "version", GP_VERSION);
     gp_reply_json(reply, db_ok ? 200 : 503, JSON_TYPE, body);
     if (!db_ok)
-        reply->retry_after = 5;
+        reply->retry_after = GP_RETRY_AFTER_SECONDS;
     return GP_ROUTE_DONE;
 }
 
@@ -109,8 +108,7 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     int rc = db ? gp_store_count(db, g.jobs) : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     if (rc) {
-        gp_problem(reply, 503, GP_PROBLEM_INTERNAL, req->path, "the job store cannot be read");
-        reply->retry_after = 5;
+        gp_problem_store_unavailable(reply, req->path);
         return GP_ROUTE_DONE;
     }
     g.queue_depth = atomic_load(&svc->queued);

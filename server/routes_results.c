@@ -17,11 +17,9 @@ static int without_result(gp_request *req, gp_db *db, gp_reply *reply)
     gp_job job;
     int rc = gp_store_get_job(db, req->id, &job);
     if (rc == GP_SRV_ENOTFOUND) {
-        gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_JOB, req->path,
-                   "there is no job '%s' (never submitted, or deleted)", req->id);
+        gp_problem_no_such_job(reply, req->path, req->id);
     } else if (rc) {
-        gp_problem(reply, 503, GP_PROBLEM_INTERNAL, req->path, "the job store is not available");
-        reply->retry_after = 5;
+        gp_problem_store_unavailable(reply, req->path);
     } else if (job.status == GP_JOB_ACCEPTED || job.status == GP_JOB_RUNNING) {
         gp_problem(reply, 404, GP_PROBLEM_RESULT_NOT_READY, req->path,
                    "job %s is %s (%d%%); the result is ready when its status is successful "
@@ -42,8 +40,7 @@ static int without_result(gp_request *req, gp_db *db, gp_reply *reply)
 static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp_reply *reply)
 {
     if (!db) {
-        gp_problem(reply, 503, GP_PROBLEM_INTERNAL, req->path, "the job store is not available");
-        reply->retry_after = 5;
+        gp_problem_store_unavailable(reply, req->path);
         return 1;
     }
     if (without_result(req, db, reply))
