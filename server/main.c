@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "config.h"
 #include "http.h"
@@ -89,10 +90,10 @@ int main(int argc, char **argv)
     unsigned port;
     if (gp_http_start(&svc, &http, &port))
         goto done;
-    gp_log("grainpackd %s listening on %s port %u; store %s (%ld jobs waiting, %d of them "
-           "queued again after a stop); %d workers",
-           GP_VERSION, cfg.host, port, cfg.db_path, counts[GP_JOB_ACCEPTED], requeued,
-           cfg.workers);
+    gp_log("grainpackd %s (pid %ld) listening on %s port %u; store %s (%ld jobs waiting, %d "
+           "of them queued again after a stop); %d workers",
+           GP_VERSION, (long)getpid(), cfg.host, port, cfg.db_path, counts[GP_JOB_ACCEPTED],
+           requeued, cfg.workers);
     if (cfg.ready_file[0] && write_ready_file(cfg.ready_file, port))
         goto done;
 
