@@ -60,7 +60,6 @@ typedef struct request_state {
     size_t discarded;
     int answered;    /* a response was queued */
     int suspended;   /* a long-poll is waiting */
-    gp_waiter *waiter;
     char method[8], path[200]; /* for the log line */
     unsigned status;
     size_t bytes;
@@ -304,7 +303,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
     gp_route_fn fn = is_get ? rt->get : strcmp(method, "POST") == 0 ? rt->post : rt->del;
     gp_request req = {svc,     conn,    method, url, st->id, st->body ? st->body : "",
-                      st->len, st->suspended, &st->waiter};
+                      st->len, st->suspended};
     st->suspended = 0;
     if (fn(&req, &reply) == GP_ROUTE_SUSPENDED) {
         st->suspended = 1;

@@ -22,7 +22,6 @@ typedef struct gp_request {
     const char *body;   /* POST: the body (not NUL-terminated), else NULL */
     size_t body_len;
     int resumed;        /* called again after a long-poll suspension */
-    gp_waiter **waiter; /* where a route keeps its long-poll entry across the suspension */
 } gp_request;
 
 /* What a route did: answered (reply filled) or suspended the connection (long-poll). */
