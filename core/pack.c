@@ -102,13 +102,18 @@ static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
 
 /* Whether a packing disk of radius R centred at (x, y) fits: inside the domain,
  * overlapping no disk but the two it was placed against, and crossing no barrier of the
- * front but the segment it was placed against. */
+ * front but the segment it was placed against. *blocker (when not NULL) gets the disk in
+ * the way, or GP_GRID_NONE. */
 static int fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
-                int32_t skip_segment)
+                int32_t skip_segment, int32_t *blocker)
 {
-    return gp_domain_contains_disk(pk->params->domain, x, y, R, R * GP_CONTACT_RTOL) &&
-           gp_grid_first_overlap(&pk->grid, pk->disks, x, y, R, skip_a, skip_b) == GP_GRID_NONE &&
-           front_barrier_crossed(&pk->fr, x, y, R, skip_segment) == FRONT_NONE;
+    int32_t q = GP_GRID_NONE;
+    int ok = gp_domain_contains_disk(pk->params->domain, x, y, R, R * GP_CONTACT_RTOL) &&
+             (q = gp_grid_first_overlap(&pk->grid, pk->disks, x, y, R, skip_a, skip_b)) == GP_GRID_NONE &&
+             front_barrier_crossed(&pk->fr, x, y, R, skip_segment) == FRONT_NONE;
+    if (blocker)
+        *blocker = q;
+    return ok;
 }
 
 /* Whether the disk (x, y, R) overlaps disk `id` (cheap test run before the grid's). */
@@ -149,7 +154,7 @@ static int build_initial_front(packer *pk)
         double scale = pk->pending_R / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
         double cx = vx[i] + scale * (nx[p] + nx[i]), cy = vy[i] + scale * (ny[p] + ny[i]);
         corner_disk[i] = -1;
-        if (fits(pk, cx, cy, pk->pending_R, -1, -1, FRONT_NONE)) {
+        if (fits(pk, cx, cy, pk->pending_R, -1, -1, FRONT_NONE, NULL)) {
             int32_t id = add_disk(pk, cx, cy, 0);
             if (id < 0)
                 return id;
@@ -287,14 +292,11 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
             nodes[u].blocker = likely[i];
             return 0;
         }
-    if (!gp_domain_contains_disk(pk->params->domain, *x, *y, R, R * GP_CONTACT_RTOL))
-        return 0;
-    int32_t q = gp_grid_first_overlap(&pk->grid, pk->disks, *x, *y, R, a, b);
-    if (q != GP_GRID_NONE) {
+    int32_t q;
+    int ok = fits(pk, *x, *y, R, a, b, u, &q);
+    if (q != GP_GRID_NONE)
         nodes[u].blocker = q;
-        return 0;
-    }
-    return front_barrier_crossed(&pk->fr, *x, *y, R, u) == FRONT_NONE;
+    return ok;
 }
 
 /* Whether node u's segment is wider than a disk of radius R can bridge. */
