@@ -2,10 +2,12 @@
  * HTTP server, and on SIGTERM/SIGINT stops accepting, queues running jobs again and
  * closes cleanly. */
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -28,6 +30,27 @@ static int make_db_dir(const char *db_path)
         return 0;
     gp_log("cannot create the data directory %s: %s", dir, strerror(errno));
     return -1;
+}
+
+/* Takes DB_PATH.lock for the daemon's lifetime (the descriptor stays open; the kernel
+ * drops the lock when the process ends, however it ends). A second daemon on the same
+ * database would queue again the jobs the first one is running, so it must not start.
+ * Returns the descriptor or -1. */
+static int lock_database(const char *db_path)
+{
+    char path[PATH_MAX + 8];
+    snprintf(path, sizeof path, "%s.lock", db_path);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0640);
+    if (fd < 0) {
+        gp_log("cannot open %s: %s", path, strerror(errno));
+        return -1;
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        gp_log("another grainpackd is using %s (%s is locked)", db_path, path);
+        close(fd);
+        return -1;
+    }
+    return fd;
 }
 
 /* Writes the bound port to path through a rename, so a reader never sees half of it. */
@@ -65,9 +88,9 @@ int main(int argc, char **argv)
     atomic_init(&svc.queued, 0);
     atomic_init(&svc.accepting, 1);
     struct MHD_Daemon *http = NULL;
-    int status = 1, requeued = 0;
+    int status = 1, requeued = 0, lock_fd = -1;
     char why[512];
-    if (make_db_dir(cfg.db_path))
+    if (make_db_dir(cfg.db_path) || (lock_fd = lock_database(cfg.db_path)) < 0)
         goto done;
     if (gp_store_open(cfg.db_path, &svc.store, &requeued, why, sizeof why)) {
         gp_log("cannot open the job store: %s", why);
@@ -116,6 +139,8 @@ done:
     gp_waiters_free(svc.waiters);
     gp_metrics_free(svc.metrics);
     gp_store_close(svc.store);
+    if (lock_fd >= 0)
+        close(lock_fd);
     if (status == 0)
         gp_log("grainpackd stopped cleanly");
     return status;

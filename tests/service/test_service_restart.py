@@ -2,7 +2,8 @@
 """test_service_restart.py - nothing accepted is lost: a batch is submitted, the daemon
 is killed with SIGKILL while a job runs, started again on the same database; every
 accepted job reaches successful (the one that was running is queued again and run a
-second time), and the database passes PRAGMA integrity_check. A clean SIGTERM stop in
+second time), and the database passes PRAGMA integrity_check. A second daemon on the
+same database is refused. A clean SIGTERM stop in
 the middle of a job queues it again too. Usage: test_service_restart.py GRAINPACKD"""
 
 import gpd
@@ -44,6 +45,15 @@ def test(c, binary):
 
         daemon.start()
         c.check("1 of them queued again" in daemon.log(), "start-up log does not report the requeue")
+        # a second daemon on the same database would queue the running jobs again: refused
+        other = gpd.Daemon(binary, "--db", daemon.db_path)
+        try:
+            other.start()
+            c.check(False, "a second grainpackd started on the same database")
+        except AssertionError as e:
+            c.check("another grainpackd is using" in str(e), f"second daemon: {e}")
+        finally:
+            other.cleanup()
         client = daemon.client()
         for job in ids:
             info = client.wait_final(job)
