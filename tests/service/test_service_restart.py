@@ -3,8 +3,8 @@
 is killed with SIGKILL while a job runs, started again on the same database; every
 accepted job reaches successful (the one that was running is queued again and run a
 second time), and the database passes PRAGMA integrity_check. A second daemon on the
-same database is refused. A clean SIGTERM stop in
-the middle of a job queues it again too. Usage: test_service_restart.py GRAINPACKD"""
+same database is refused. A clean SIGTERM stop in the middle of a job queues it again
+too. Usage: test_service_restart.py GRAINPACKD"""
 
 import gpd
 
