@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""test_service_jobs.py - following and managing jobs: dismissing a running large job
-(its worker stops: the run ends as 'dismissed', not as a finished run whose result is
-thrown away), dismissing a queued job (it never runs), deleting finished jobs, the
+"""test_service_jobs.py - following and managing jobs: progress of a running job,
+dismissing a running large job (its worker stops: the run ends as 'dismissed', not as a
+finished run whose result is thrown away), dismissing a queued job (it never runs), deleting finished jobs, the
 long-poll woken by a dismissal, the job list's pagination and status filter, the queue
 cap (503 + Retry-After) and CORS. Usage: test_service_jobs.py GRAINPACKD"""
 
@@ -23,6 +23,14 @@ def test_dismissal(c, api, daemon, client):
     queued = client.submit(gpd.small_spec(seed=3))  # behind the big one: one worker
     queued_id = queued.json()["jobID"]
     client.wait_status(big_id, ("running",))
+    # progress is published while it packs
+    for _ in range(3000):
+        info = client.get(f"/jobs/{big_id}").json()
+        if info["progress"] > 0 or info["status"] != "running":
+            break
+        threading.Event().wait(0.02)
+    c.check(info["status"] == "running" and 0 < info["progress"] < 100
+            and info["message"].startswith("running: pack"), f"progress of the big job: {info}")
 
     # a long-poll on the running job, answered by the dismissal (not by its 60 s deadline)
     polled = {}
