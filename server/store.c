@@ -16,6 +16,9 @@
  * are short (one job row, or one result), so this is only reached when the disk stalls. */
 #define BUSY_TIMEOUT_MS 30000
 
+/* Bytes the WAL file is cut back to after a checkpoint (see PRAGMA journal_size_limit). */
+#define WAL_SIZE_LIMIT (64 << 20)
+
 /* Bytes per disk in the results blob: x, y, r, R as float64. */
 #define DISK_RECORD 32
 
@@ -158,10 +161,13 @@ static gp_db *db_open(const char *path, int durable, char *why, size_t why_size)
         return NULL;
     }
     sqlite3_busy_timeout(db->conn, BUSY_TIMEOUT_MS);
-    char pragmas[160];
+    /* journal_size_limit: a large result (tens of MB) grows the WAL; once checkpointed,
+     * the file is cut back instead of staying that large */
+    char pragmas[200];
     snprintf(pragmas, sizeof pragmas,
-             "PRAGMA journal_mode = WAL; PRAGMA synchronous = %s; PRAGMA foreign_keys = ON;",
-             durable ? "FULL" : "NORMAL");
+             "PRAGMA journal_mode = WAL; PRAGMA synchronous = %s; PRAGMA foreign_keys = ON;"
+             " PRAGMA journal_size_limit = %d;",
+             durable ? "FULL" : "NORMAL", WAL_SIZE_LIMIT);
     char *msg = NULL;
     if (sqlite3_exec(db->conn, pragmas, NULL, NULL, &msg) != SQLITE_OK ||
         sqlite3_prepare_v3(db->conn, "BEGIN IMMEDIATE", -1, SQLITE_PREPARE_PERSISTENT, &db->begin,
