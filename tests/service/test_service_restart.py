@@ -8,8 +8,8 @@ too. Usage: test_service_restart.py GRAINPACKD"""
 
 import gpd
 
-# A job long enough to be caught running (about half a million disks), then small ones.
-LONG = gpd.big_spec(side=1400)
+# A job long enough to be caught running (about a million disks), then small ones.
+LONG = gpd.big_spec(side=2000)
 SMALL = 8
 
 
