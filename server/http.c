@@ -362,7 +362,7 @@ int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port)
         flags |= MHD_USE_IPv6;
     } else {
         gp_log("http: --host must be an IPv4 or IPv6 address, got '%s'", cfg->host);
-        return -1;
+        return GP_EINVAL;
     }
     struct MHD_Daemon *d = MHD_start_daemon(
         flags, (uint16_t)cfg->port, NULL, NULL, on_request, svc, MHD_OPTION_SOCK_ADDR, addr,
@@ -373,7 +373,7 @@ int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port)
     if (!d) {
         gp_log("http: cannot listen on %s port %d (in use, or not an address of this machine)",
                cfg->host, cfg->port);
-        return -1;
+        return GP_EIO;
     }
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
     *port = info ? info->port : (unsigned)cfg->port;
