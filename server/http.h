@@ -34,7 +34,8 @@ const char *gp_request_query(const gp_request *req, const char *name);
 const char *gp_request_header(const gp_request *req, const char *name);
 
 /* Starts listening on cfg->host:cfg->port with cfg->http_threads threads. Returns 0 with
- * the daemon and the port actually bound (cfg->port may be 0), GP_EINVAL (--host is not an address) or GP_EIO (cannot listen), after logging why. */
+ * the daemon and the port actually bound (cfg->port may be 0), or, after logging why,
+ * GP_EINVAL (--host is not an address) or GP_EIO (cannot listen). */
 int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port);
 
 /* Stops accepting new connections (in-flight requests go on). */
