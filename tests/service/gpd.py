@@ -300,8 +300,8 @@ def small_spec(seed=1, side=30):
                        "joint": {"law": "constant", "value": 0.1}, "seed": seed}}
 
 
-def big_spec(side=3000):
-    """A job that runs for seconds: ~2.6 million disks for the default side."""
+def big_spec(side=4000):
+    """A job that runs for seconds: ~4.6 million disks for the default side."""
     return {"inputs": {"domain": {"width": side, "height": side},
                        "distribution": {"kind": "constant", "radius": 1.0}}}
 
