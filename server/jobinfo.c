@@ -23,7 +23,7 @@ json_t *gp_job_status_info(const gp_job *job)
         json_array_append_new(links,
                               json_pack("{s:s, s:s, s:s, s:s}", "href", results, "rel",
                                         "http://www.opengis.net/def/rel/ogc/1.0/results", "type",
-                                        "application/json", "title", "the result (?f=json|csv|svg)"));
+                                        "application/json", "title", "the result (?f= picks the format)"));
         json_array_append_new(links, json_pack("{s:s, s:s, s:s, s:s}", "href", stats, "rel",
                                                "statistics", "type", "application/json", "title",
                                                "densities, distribution fidelity, timings"));
