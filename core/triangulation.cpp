@@ -1,0 +1,268 @@
+// triangulation.cpp - the only C++ of grainpack: CGAL's Regular_triangulation_2 (exact
+// predicates, inexact constructions) of the disk centres with weights R^2, behind the C
+// API of grainpack/triangulation.h. Every entry point catches every exception.
+#include "grainpack/triangulation.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <exception>
+#include <new>
+#include <utility>
+#include <vector>
+
+namespace {
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
+typedef CGAL::Regular_triangulation_vertex_base_2<K> Vb0;
+typedef CGAL::Triangulation_vertex_base_with_info_2<int32_t, K, Vb0> Vb;
+typedef CGAL::Regular_triangulation_face_base_2<K> Fb;
+typedef CGAL::Triangulation_data_structure_2<Vb, Fb> Tds;
+typedef CGAL::Regular_triangulation_2<K, Tds> Rt;
+typedef Rt::Vertex_handle Vertex_handle;
+typedef Rt::Face_handle Face_handle;
+typedef K::Point_2 Point;
+typedef K::Weighted_point_2 Weighted_point;
+
+// A vertex's flips are capped: Lawson's flips end after a number of flips bounded by the
+// edges the move touches, a few dozen here; far beyond that something is wrong and the
+// triangulation is built again instead.
+const int MAX_FLIPS_PER_MOVE = 10000;
+
+Weighted_point weighted(const gp_disk &d)
+{
+    return Weighted_point(Point(d.x, d.y), d.R * d.R);
+}
+
+} // namespace
+
+struct gp_rt {
+    Rt rt;
+    std::vector<Vertex_handle> vertex;                // by disk id
+    std::vector<std::pair<Face_handle, int>> edges;   // the flip stack, kept between moves
+};
+
+namespace {
+
+// Fills t.rt and t.vertex from the disks; returns 0 or GP_EGEOM (hidden vertex) with err.
+int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
+{
+    t.rt.clear();
+    std::vector<std::pair<Weighted_point, int32_t>> points;
+    points.reserve(n);
+    for (size_t i = 0; i < n; i++)
+        points.emplace_back(weighted(disks[i]), static_cast<int32_t>(i));
+    t.rt.insert(points.begin(), points.end()); // spatially sorted, deterministic order
+    t.vertex.assign(n, Vertex_handle());
+    for (Rt::Finite_vertices_iterator v = t.rt.finite_vertices_begin();
+         v != t.rt.finite_vertices_end(); ++v) {
+        int32_t id = v->info();
+        if (id < 0 || static_cast<size_t>(id) >= n || t.vertex[id] != Vertex_handle())
+            return gp_error_set(err, GP_EGEOM, NULL,
+                                "regular triangulation: two vertices claim disk %d", id);
+        t.vertex[id] = v;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (t.vertex[i] == Vertex_handle())
+            return gp_error_set(err, GP_EGEOM, NULL,
+                                "regular triangulation: disk %zu at (%.17g, %.17g), R = %.17g, is "
+                                "hidden (it overlaps another disk or shares its centre)",
+                                i, disks[i].x, disks[i].y, disks[i].R);
+    return 0;
+}
+
+// Lawson's flips from the edges of the faces around v until every edge they reach is
+// locally regular. Returns false when a non-regular edge cannot be flipped (its
+// quadrilateral is not convex) or the flips run away.
+bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int>> &stack,
+                 gp_rt_update_stats &stats)
+{
+    // every edge whose two triangles have v as a vertex: the link edge and one spoke of
+    // each triangle around v (the other spoke is the next triangle's)
+    stack.clear();
+    Rt::Face_circulator fc = rt.incident_faces(v), done = fc;
+    do {
+        int i = fc->index(v);
+        stack.emplace_back(fc, i);
+        stack.emplace_back(fc, Rt::ccw(i));
+    } while (++fc != done);
+    int flips = 0;
+    while (!stack.empty()) {
+        Face_handle f = stack.back().first;
+        int i = stack.back().second;
+        stack.pop_back();
+        Face_handle g = f->neighbor(i);
+        if (rt.is_infinite(f) || rt.is_infinite(g))
+            continue; // hull edges: the hull does not change, see gp_rt_update_moved
+        const Weighted_point &d = g->vertex(g->index(f))->point();
+        if (rt.power_test(f, d) != CGAL::ON_POSITIVE_SIDE)
+            continue; // locally regular (or exactly co-power-circular: either diagonal)
+        const Weighted_point &a = f->vertex(i)->point();
+        const Weighted_point &b = f->vertex(Rt::ccw(i))->point();
+        const Weighted_point &c = f->vertex(Rt::cw(i))->point();
+        if (rt.orientation(a, b, d) != CGAL::LEFT_TURN || rt.orientation(a, d, c) != CGAL::LEFT_TURN)
+            return false;
+        if (++flips > MAX_FLIPS_PER_MOVE)
+            return false;
+        rt.flip(f, i);
+        stats.flips++;
+        for (int j = 0; j < 3; j++) {
+            stack.emplace_back(f, j);
+            stack.emplace_back(g, j);
+        }
+    }
+    return true;
+}
+
+// Whether v can move to p without folding a triangle of its star: v must be interior and
+// p on the left of every edge of its link.
+bool can_move_in_place(const Rt &rt, Vertex_handle v, const Point &p)
+{
+    Rt::Face_circulator fc = rt.incident_faces(v), done = fc;
+    do {
+        if (rt.is_infinite(fc))
+            return false;
+        int i = fc->index(v);
+        if (CGAL::orientation(p, fc->vertex(Rt::ccw(i))->point().point(),
+                              fc->vertex(Rt::cw(i))->point().point()) != CGAL::LEFT_TURN)
+            return false;
+    } while (++fc != done);
+    return true;
+}
+
+enum move_outcome { MOVED, NEEDS_REBUILD };
+
+move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_update_stats &stats)
+{
+    Vertex_handle v = t.vertex[id];
+    if (t.rt.dimension() < 2)
+        return NEEDS_REBUILD;
+    if (can_move_in_place(t.rt, v, wp.point())) {
+        v->set_point(wp);
+        stats.moved_in_place++;
+        return flip_around(t.rt, v, t.edges, stats) ? MOVED : NEEDS_REBUILD;
+    }
+    // remove and insert again: the triangulation stays regular throughout
+    Vertex_handle near;
+    Rt::Vertex_circulator c = t.rt.incident_vertices(v), done = c;
+    do
+        near = c;
+    while (t.rt.is_infinite(near) && ++c != done);
+    t.rt.remove(v);
+    Vertex_handle w = t.rt.insert(wp, near->face());
+    if (w == Vertex_handle() || w->is_hidden() || t.rt.number_of_hidden_vertices() > 0)
+        return NEEDS_REBUILD; // the rebuild names the disk
+    w->info() = id;
+    t.vertex[id] = w;
+    stats.reinserted++;
+    return MOVED;
+}
+
+} // namespace
+
+extern "C" int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err)
+{
+    *out = NULL;
+    if (n > static_cast<size_t>(INT32_MAX))
+        return gp_error_set(err, GP_ETOOBIG, NULL, "regular triangulation: %zu disks, more than %d",
+                            n, INT32_MAX);
+    gp_rt *t = NULL;
+    try {
+        t = new gp_rt;
+        int rc = build_into(*t, disks, n, err);
+        if (rc) {
+            delete t;
+            return rc;
+        }
+    } catch (const std::bad_alloc &) {
+        delete t;
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory building the triangulation of %zu disks", n);
+    } catch (const std::exception &e) {
+        delete t;
+        return gp_error_set(err, GP_EINTERNAL, NULL, "regular triangulation: %s", e.what());
+    } catch (...) {
+        delete t;
+        return gp_error_set(err, GP_EINTERNAL, NULL, "regular triangulation: unknown failure");
+    }
+    *out = t;
+    return 0;
+}
+
+extern "C" void gp_rt_free(gp_rt *rt)
+{
+    delete rt;
+}
+
+extern "C" size_t gp_rt_count(const gp_rt *rt)
+{
+    return rt->vertex.size();
+}
+
+extern "C" int gp_rt_dimension(const gp_rt *rt)
+{
+    return rt->rt.dimension();
+}
+
+extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap, int *hull)
+{
+    const Rt &r = rt->rt;
+    Vertex_handle v = rt->vertex[id];
+    *hull = 1;
+    if (r.dimension() < 1)
+        return 0;
+    size_t n = 0, after_infinite = 0;
+    bool infinite = false;
+    Rt::Vertex_circulator c = r.incident_vertices(v), done = c;
+    do {
+        if (r.is_infinite(c)) {
+            infinite = true;
+            after_infinite = n;
+            continue;
+        }
+        if (n < cap)
+            out[n] = c->info();
+        n++;
+    } while (++c != done);
+    if (r.dimension() < 2)
+        return n;
+    *hull = infinite ? 1 : 0;
+    if (infinite && n <= cap) // start just after the outside of the hull
+        std::rotate(out, out + after_infinite, out + n);
+    return n;
+}
+
+extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks,
+                                  const int32_t *ids, size_t nids, gp_rt_update mode,
+                                  gp_rt_update_stats *stats, gp_error *err)
+{
+    gp_rt_update_stats local = {0, 0, 0, 0};
+    gp_rt_update_stats &st = stats ? *stats : local;
+    try {
+        bool rebuild = mode == GP_RT_UPDATE_REBUILD;
+        for (size_t k = 0; k < nids && !rebuild; k++)
+            rebuild = move_vertex(*rt, ids[k], weighted(disks[ids[k]]), st) == NEEDS_REBUILD;
+        if (rebuild) {
+            st.rebuilds++;
+            return build_into(*rt, disks, ndisks, err);
+        }
+        return 0;
+    } catch (const std::bad_alloc &) {
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory updating the triangulation");
+    } catch (const std::exception &e) {
+        return gp_error_set(err, GP_EINTERNAL, NULL, "regular triangulation: %s", e.what());
+    } catch (...) {
+        return gp_error_set(err, GP_EINTERNAL, NULL, "regular triangulation: unknown failure");
+    }
+}
+
+extern "C" int gp_rt_is_regular(const gp_rt *rt)
+{
+    try {
+        return rt->rt.is_valid() && rt->rt.number_of_hidden_vertices() == 0;
+    } catch (...) {
+        return 0;
+    }
+}

@@ -1,0 +1,91 @@
+/* triangulation.h - the regular (weighted Delaunay) triangulation of the disk centres with
+ * weights R^2 (SPEC §4.1, §5), behind a C API. The one C++ file core/triangulation.cpp
+ * holds it in a CGAL Regular_triangulation_2 with exact predicates; nothing here shows a
+ * C++ type, and no C++ exception crosses this API. */
+#ifndef GRAINPACK_TRIANGULATION_H
+#define GRAINPACK_TRIANGULATION_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/disk.h"
+#include "grainpack/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Opaque: owns the CGAL triangulation and a table from disk id (the index in the disks
+ * array it was built from) to vertex. Not safe to use from two threads at once; two
+ * triangulations on two threads are independent. */
+typedef struct gp_rt gp_rt;
+
+/* Builds the regular triangulation of the centres of disks[0..n-1] with weights R^2
+ * (power distance |x - c|^2 - R^2). The disks are read, not kept. On success returns 0
+ * and *out owns the triangulation (free with gp_rt_free). Fails with GP_ENOMEM,
+ * GP_ETOOBIG (n does not fit an int32_t id), GP_EGEOM when some disk has no vertex (a
+ * hidden vertex: its disk lies inside the power cells of others, which non-overlapping
+ * packing disks never do; also two disks with the same centre), or GP_EINTERNAL when CGAL
+ * reports a failure; err says which disk or what CGAL said, and *out is NULL. */
+int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err);
+
+/* Frees the triangulation (no-op on NULL). */
+void gp_rt_free(gp_rt *rt);
+
+/* The number of vertices (= disks). */
+size_t gp_rt_count(const gp_rt *rt);
+
+/* The dimension of the triangulation: -1 empty, 0 one vertex, 1 all centres collinear,
+ * 2 otherwise. Only dimension 2 has interior vertices and balls. */
+int gp_rt_dimension(const gp_rt *rt);
+
+/* The neighbours of vertex `id` (its ring), counter-clockwise around it. Writes the
+ * first `cap` of them to `out` and returns how many there are (call again with a larger
+ * buffer when that exceeds cap). *on_hull is set to 1 when the vertex is on the convex
+ * hull of the centres (always, in dimension < 2), else 0.
+ *
+ * In dimension 2 the ring is the dual of the vertex's power cell: neighbour k shares
+ * the cell edge on the radical line of the two disks. For an interior vertex p, the
+ * triangles around it (its ball) are (p, out[k], out[k+1 mod degree]), and the boundary
+ * edges of the ball (its link) are (out[k], out[k+1 mod degree]), each with p on its left.
+ * For a hull vertex the ring starts just after the convex hull's outside and ends just
+ * before it: the triangles and link edges are those with k + 1 < degree, and
+ * (p, out[0]) and (out[degree-1], p) are hull edges. */
+size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap, int *on_hull);
+
+/* How to bring the triangulation up to date after centres moved. */
+typedef enum gp_rt_update {
+    /* Each moved vertex is moved in place and the regular property restored by edge
+     * flips around it (report Algorithm 3: "basculer les arêtes"); a vertex on the hull,
+     * or whose move would fold a triangle, is removed and inserted again. Should a flip
+     * ever be impossible (a non-convex quadrilateral) the whole triangulation is built
+     * again. */
+    GP_RT_UPDATE_FLIPS = 0,
+    /* The whole triangulation is built again from all the disks. */
+    GP_RT_UPDATE_REBUILD
+} gp_rt_update;
+
+/* What an update did, added to the counters of *stats. */
+typedef struct gp_rt_update_stats {
+    uint64_t moved_in_place; /* vertices moved where they were, then flipped around */
+    uint64_t flips;          /* edge flips done */
+    uint64_t reinserted;     /* vertices removed and inserted again */
+    uint64_t rebuilds;       /* full builds */
+} gp_rt_update_stats;
+
+/* Brings the triangulation up to date after the centres of disks[ids[k]] (k < nids)
+ * moved; `disks` is the array it was built from, with the new positions (the radii must
+ * not have changed). Returns 0 or, as gp_rt_build, GP_ENOMEM, GP_EGEOM or GP_EINTERNAL;
+ * on failure the triangulation must only be freed. `stats` may be NULL. */
+int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks, const int32_t *ids,
+                       size_t nids, gp_rt_update mode, gp_rt_update_stats *stats, gp_error *err);
+
+/* Whether the triangulation is a valid regular triangulation of its current points
+ * (CGAL's own check: every triangle counter-clockwise, every edge locally regular, no
+ * hidden vertex). Costly; for the tests. */
+int gp_rt_is_regular(const gp_rt *rt);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
