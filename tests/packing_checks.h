@@ -9,6 +9,7 @@
 #include "grainpack/disk.h"
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
+#include "grainpack/pack.h"
 #include "grainpack/spec.h"
 
 /* Two packing disks overlap when their centres are closer than (R1 + R2)(1 - 1e-9).
@@ -105,6 +106,17 @@ static inline void load_example(const char *name, gp_spec *spec)
     gp_error err;
     if (gp_spec_load_file(path, NULL, spec, &err)) {
         fprintf(stderr, "cannot load %s: %s %s\n", path, err.pointer, err.message);
+        exit(2);
+    }
+}
+
+/* Packs `spec` with `seed` (its own level band), aborting the test program if it cannot. */
+static inline void pack_seed(const gp_spec *spec, uint64_t seed, gp_packing *pk)
+{
+    gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, seed, 0, spec->level_band};
+    gp_error err;
+    if (gp_pack(&params, NULL, pk, &err)) {
+        fprintf(stderr, "cannot pack seed %llu: %s\n", (unsigned long long)seed, err.message);
         exit(2);
     }
 }

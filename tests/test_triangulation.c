@@ -1,0 +1,268 @@
+/* test_triangulation.c - the regular triangulation module: rings counter-clockwise with
+ * the hull where the header says, the empty-power-circle property checked by brute force,
+ * hidden vertices reported, degenerate inputs, and updates after moves (flips, reinsertion,
+ * rebuild) that end in the same triangulation as a fresh build. */
+#include <stdlib.h>
+
+#include "check.h"
+#include "grainpack/pack.h"
+#include "grainpack/rng.h"
+#include "grainpack/triangulation.h"
+#include "packing_checks.h"
+
+/* A hexagonal patch of `rows` x `cols` touching disks of packing radius 1. */
+static size_t hex_patch(gp_disk *d, int rows, int cols, double x0, double y0)
+{
+    size_t n = 0;
+    for (int i = 0; i < rows; i++)
+        for (int j = 0; j < cols; j++)
+            d[n++] = (gp_disk){x0 + 2.0 * j + (i % 2), y0 + sqrt(3.0) * i, 0.9, 1.0};
+    return n;
+}
+
+/* The ring of id, aborting the test on a buffer too small (64 is plenty here). */
+static size_t ring(const gp_rt *rt, int32_t id, int32_t *out, int *hull)
+{
+    size_t degree = gp_rt_ring(rt, id, out, 64, hull);
+    CHECK(degree <= 64);
+    return degree;
+}
+
+static void test_hexagonal_patch_rings_are_six_touching_neighbours_ccw(void)
+{
+    gp_disk d[49];
+    size_t n = hex_patch(d, 7, 7, 0.0, 0.0);
+    gp_rt *rt;
+    gp_error err;
+    CHECK(gp_rt_build(d, n, &rt, &err) == 0);
+    CHECK(gp_rt_count(rt) == n && gp_rt_dimension(rt) == 2);
+    size_t interior = 0;
+    for (size_t i = 0; i < n; i++) {
+        int32_t nb[64];
+        int hull;
+        size_t deg = ring(rt, (int32_t)i, nb, &hull);
+        int row = (int)i / 7, col = (int)i % 7;
+        int on_border = row == 0 || row == 6 || col == 0 || col == 6;
+        if (!on_border) {
+            /* an interior disk of the patch: six neighbours, all touching, the triangles
+             * (p, nb[k], nb[k+1]) counter-clockwise */
+            CHECK_MSG(!hull && deg == 6, "disk %zu: hull %d degree %zu", i, hull, deg);
+            for (size_t k = 0; k < deg; k++) {
+                const gp_disk *q = &d[nb[k]], *r = &d[nb[(k + 1) % deg]];
+                CHECK_NEAR(hypot(q->x - d[i].x, q->y - d[i].y), 2.0, 1e-12);
+                CHECK(gp_orient2d(d[i].x, d[i].y, q->x, q->y, r->x, r->y) > 0.0);
+            }
+            interior++;
+        }
+    }
+    CHECK(interior == 25);
+    gp_rt_free(rt);
+}
+
+/* For a hull vertex p with ring nb: the edges p -> nb[0] and nb[deg-1] -> p are hull
+ * edges, every centre on their left or on them. */
+static void check_hull_ring(const gp_disk *d, size_t n, size_t i, const int32_t *nb, size_t deg)
+{
+    const gp_disk *p = &d[i], *first = &d[nb[0]], *last = &d[nb[deg - 1]];
+    for (size_t q = 0; q < n; q++) {
+        CHECK_MSG(gp_orient2d(p->x, p->y, first->x, first->y, d[q].x, d[q].y) >= 0.0,
+                  "disk %zu right of the hull edge %zu -> %d", q, i, nb[0]);
+        CHECK_MSG(gp_orient2d(last->x, last->y, p->x, p->y, d[q].x, d[q].y) >= 0.0,
+                  "disk %zu right of the hull edge %d -> %zu", q, nb[deg - 1], i);
+    }
+}
+
+/* Random disjoint disks of varied radii in a square, by rejection. */
+static size_t random_disks(gp_disk *d, size_t want, double side, uint64_t seed)
+{
+    gp_rng rng;
+    gp_rng_seed(&rng, seed);
+    size_t n = 0;
+    for (int tries = 0; n < want && tries < 100000; tries++) {
+        double R = 0.2 + 0.8 * gp_rng_uniform(&rng);
+        gp_disk c = {R + (side - 2 * R) * gp_rng_uniform(&rng), R + (side - 2 * R) * gp_rng_uniform(&rng),
+                     0.9 * R, R};
+        int ok = 1;
+        for (size_t k = 0; k < n && ok; k++)
+            ok = hypot(c.x - d[k].x, c.y - d[k].y) >= c.R + d[k].R;
+        if (ok)
+            d[n++] = c;
+    }
+    return n;
+}
+
+/* The power circle of triangle (a, b, c): the point o with equal power to all three, and
+ * that power. */
+static void orthocentre(const gp_disk *a, const gp_disk *b, const gp_disk *c, double *ox,
+                        double *oy, double *power)
+{
+    double bx = b->x - a->x, by = b->y - a->y, cx = c->x - a->x, cy = c->y - a->y;
+    double kb = 0.5 * (bx * bx + by * by + a->R * a->R - b->R * b->R);
+    double kc = 0.5 * (cx * cx + cy * cy + a->R * a->R - c->R * c->R);
+    double det = bx * cy - by * cx;
+    double ux = (kb * cy - kc * by) / det, uy = (bx * kc - cx * kb) / det;
+    *ox = a->x + ux;
+    *oy = a->y + uy;
+    *power = ux * ux + uy * uy - a->R * a->R;
+}
+
+static void test_triangles_have_empty_power_circles_by_brute_force(void)
+{
+    enum { WANT = 300 };
+    for (uint64_t seed = 1; seed <= 5; seed++) {
+        gp_disk d[WANT];
+        size_t n = random_disks(d, WANT, 30.0, seed);
+        gp_rt *rt;
+        gp_error err;
+        CHECK(gp_rt_build(d, n, &rt, &err) == 0);
+        CHECK(gp_rt_is_regular(rt));
+        size_t triangles = 0, hull = 0;
+        for (size_t i = 0; i < n; i++) {
+            int32_t nb[64];
+            int on_hull;
+            size_t deg = ring(rt, (int32_t)i, nb, &on_hull);
+            if (on_hull) {
+                hull++;
+                check_hull_ring(d, n, i, nb, deg);
+            }
+            for (size_t k = 0; k + (on_hull ? 1 : 0) < deg; k++) {
+                const gp_disk *a = &d[i], *b = &d[nb[k]], *c = &d[nb[(k + 1) % deg]];
+                CHECK(gp_orient2d(a->x, a->y, b->x, b->y, c->x, c->y) > 0.0);
+                double ox, oy, power;
+                orthocentre(a, b, c, &ox, &oy, &power);
+                /* no centre has less power at o than the triangle's own three (with a
+                 * relative margin for the rounding of o) */
+                for (size_t q = 0; q < n; q++) {
+                    double pq = (ox - d[q].x) * (ox - d[q].x) + (oy - d[q].y) * (oy - d[q].y) - d[q].R * d[q].R;
+                    CHECK_MSG(pq >= power - 1e-9 * (fabs(power) + 1.0), "seed %llu: disk %zu in the power circle of (%zu, %d, %d)",
+                              (unsigned long long)seed, q, i, nb[k], nb[(k + 1) % deg]);
+                }
+                triangles++;
+            }
+        }
+        /* Euler: each triangle is counted at its three corners; 2n - 2 - h triangles */
+        CHECK_MSG(triangles == 3 * (2 * n - 2 - hull), "%zu corners for %zu vertices, %zu on the hull", triangles, n, hull);
+        gp_rt_free(rt);
+    }
+}
+
+static void test_hidden_and_duplicate_disks_are_geometry_errors(void)
+{
+    /* a small disk near the centre of a big one: its power cell is empty */
+    gp_disk nested[4] = {{0, 0, 1, 1}, {5, 0, 1, 1}, {0, 5, 1, 1}, {0.05, 0, 0.05, 0.1}};
+    gp_rt *rt;
+    gp_error err;
+    CHECK(gp_rt_build(nested, 4, &rt, &err) == GP_EGEOM);
+    CHECK(rt == NULL);
+    CHECK_MSG(strstr(err.message, "disk 3") && strstr(err.message, "hidden"), "%s", err.message);
+
+    gp_disk twins[4] = {{0, 0, 1, 1}, {5, 0, 1, 1}, {0, 5, 1, 1}, {5, 0, 1, 1}};
+    CHECK(gp_rt_build(twins, 4, &rt, &err) == GP_EGEOM);
+    CHECK(strstr(err.message, "hidden") != NULL);
+}
+
+static void test_degenerate_inputs_have_rings_too(void)
+{
+    gp_rt *rt;
+    gp_error err;
+    int32_t nb[64];
+    int hull;
+    CHECK(gp_rt_build(NULL, 0, &rt, &err) == 0);
+    CHECK(gp_rt_count(rt) == 0 && gp_rt_dimension(rt) == -1);
+    gp_rt_free(rt);
+
+    gp_disk one = {1, 1, 0.5, 1};
+    CHECK(gp_rt_build(&one, 1, &rt, &err) == 0);
+    CHECK(gp_rt_dimension(rt) == 0 && ring(rt, 0, nb, &hull) == 0 && hull == 1);
+    gp_rt_free(rt);
+
+    /* a row: dimension 1, each disk's neighbours are the ones beside it */
+    gp_disk row[5];
+    for (int i = 0; i < 5; i++)
+        row[i] = (gp_disk){1.0 + 2.0 * ((i * 3) % 5), 1.0, 0.9, 1.0};
+    CHECK(gp_rt_build(row, 5, &rt, &err) == 0);
+    CHECK(gp_rt_dimension(rt) == 1);
+    for (int i = 0; i < 5; i++) {
+        size_t deg = ring(rt, i, nb, &hull);
+        int ends = row[i].x == 1.0 || row[i].x == 9.0;
+        CHECK_MSG(deg == (ends ? 1u : 2u) && hull, "disk at x = %g: %zu neighbours", row[i].x, deg);
+        for (size_t k = 0; k < deg; k++)
+            CHECK_NEAR(fabs(row[nb[k]].x - row[i].x), 2.0, 0.0);
+    }
+    gp_rt_free(rt);
+}
+
+/* Whether the rings of two triangulations of the same disks hold the same neighbours. */
+static size_t count_ring_differences(const gp_rt *a, const gp_rt *b, size_t n)
+{
+    size_t differ = 0;
+    for (size_t i = 0; i < n; i++) {
+        int32_t na[64], nb[64];
+        int ha, hb;
+        size_t da = ring(a, (int32_t)i, na, &ha), db = ring(b, (int32_t)i, nb, &hb);
+        int same = da == db && ha == hb;
+        for (size_t k = 0; k < da && same; k++) {
+            int found = 0;
+            for (size_t m = 0; m < db; m++)
+                found |= na[k] == nb[m];
+            same = found;
+        }
+        differ += !same;
+    }
+    return differ;
+}
+
+static void test_updates_after_moves_match_a_fresh_build(void)
+{
+    gp_spec spec;
+    load_example("variable", &spec);
+    gp_packing pk;
+    gp_error err;
+    pack_seed(&spec, 3, &pk);
+    /* shrunk to a third, the disks can move far without overlapping: moves of up to 0.4
+     * of the original radius along each axis fold some triangles (reinsertion) and flip
+     * many edges, and keep every pair (R1 + R2)(1 - 0.57) >= (R1 + R2) / 3 apart */
+    for (size_t i = 0; i < pk.count; i++)
+        pk.disks[i].R *= 1.0 / 3.0;
+    gp_rt *rt, *fresh;
+    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    gp_rng rng;
+    gp_rng_seed(&rng, 7);
+    int32_t *ids = malloc(pk.count * sizeof *ids);
+    gp_rt_update_stats st = {0, 0, 0, 0};
+    for (int round = 0; round < 3; round++) {
+        size_t moved = 0;
+        for (size_t i = 0; i < pk.count; i += 2) {
+            double step = (round == 2 ? 1.2 : 0.3) * pk.disks[i].R;
+            pk.disks[i].x += step * (2.0 * gp_rng_uniform(&rng) - 1.0);
+            pk.disks[i].y += step * (2.0 * gp_rng_uniform(&rng) - 1.0);
+            ids[moved++] = (int32_t)i;
+        }
+        CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, moved, GP_RT_UPDATE_FLIPS, &st, &err) == 0);
+        CHECK(gp_rt_is_regular(rt));
+        CHECK(gp_rt_build(pk.disks, pk.count, &fresh, &err) == 0);
+        CHECK_MSG(count_ring_differences(rt, fresh, pk.count) == 0, "round %d", round);
+        gp_rt_free(fresh);
+    }
+    CHECK_MSG(st.moved_in_place > 0 && st.flips > 0 && st.reinserted > 0 && st.rebuilds == 0,
+              "in place %llu, flips %llu, reinserted %llu, rebuilds %llu", (unsigned long long)st.moved_in_place,
+              (unsigned long long)st.flips, (unsigned long long)st.reinserted, (unsigned long long)st.rebuilds);
+    /* the rebuild mode gives the same triangulation */
+    gp_rt_update_stats rb = {0, 0, 0, 0};
+    CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, 1, GP_RT_UPDATE_REBUILD, &rb, &err) == 0);
+    CHECK(rb.rebuilds == 1 && gp_rt_is_regular(rt));
+    free(ids);
+    gp_rt_free(rt);
+    gp_packing_free(&pk);
+    gp_spec_free(&spec);
+}
+
+int main(void)
+{
+    RUN(test_hexagonal_patch_rings_are_six_touching_neighbours_ccw);
+    RUN(test_triangles_have_empty_power_circles_by_brute_force);
+    RUN(test_hidden_and_duplicate_disks_are_geometry_errors);
+    RUN(test_degenerate_inputs_have_rings_too);
+    RUN(test_updates_after_moves_match_a_fresh_build);
+    return check_status();
+}
