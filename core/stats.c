@@ -7,8 +7,7 @@
 
 #include "grainpack/error.h"
 
-/* The bin holding r among bins sorted by min, or -1 when r lies in none of them. */
-static long find_bin(const gp_bin_stat *bins, size_t n, double r)
+long gp_bin_table_find(const gp_bin_stat *bins, size_t n, double r)
 {
     size_t lo = 0, hi = n;
     while (lo < hi) { /* first bin with min > r */
@@ -27,27 +26,49 @@ static long find_bin(const gp_bin_stat *bins, size_t n, double r)
     return -1;
 }
 
+int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **out, size_t *nbins)
+{
+    size_t n = gp_distribution_report_bins(dist, NULL, 0);
+    gp_bin *bins = malloc((n ? n : 1) * sizeof *bins);
+    *out = calloc(n ? n : 1, sizeof **out);
+    *nbins = 0;
+    if (!bins || !*out) {
+        free(bins);
+        free(*out);
+        *out = NULL;
+        return GP_ENOMEM;
+    }
+    gp_distribution_report_bins(dist, bins, n);
+    for (size_t i = 0; i < n; i++) {
+        (*out)[i].min = bins[i].min;
+        (*out)[i].max = bins[i].max;
+        (*out)[i].target = bins[i].p;
+    }
+    free(bins);
+    *nbins = n;
+    return 0;
+}
+
+void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z)
+{
+    *max_abs_z = 0.0;
+    for (size_t i = 0; i < nbins; i++) {
+        gp_bin_stat *b = &bins[i];
+        b->achieved = n ? (double)b->count / (double)n : 0.0;
+        double se = n ? sqrt(b->target * (1.0 - b->target) / (double)n) : 0.0;
+        b->z = se > 0.0 ? (b->achieved - b->target) / se : 0.0;
+        if (fabs(b->z) > *max_abs_z)
+            *max_abs_z = fabs(b->z);
+    }
+}
+
 int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
                           const gp_packing *packing, gp_pack_stats *out)
 {
     memset(out, 0, sizeof *out);
-    size_t nbins = gp_distribution_report_bins(dist, NULL, 0);
-    gp_bin *bins = malloc((nbins ? nbins : 1) * sizeof *bins);
-    out->bins = calloc(nbins ? nbins : 1, sizeof *out->bins);
-    if (!bins || !out->bins) {
-        free(bins);
-        free(out->bins);
-        out->bins = NULL;
+    if (gp_bin_table_init(dist, &out->bins, &out->nbins))
         return GP_ENOMEM;
-    }
-    gp_distribution_report_bins(dist, bins, nbins);
-    out->nbins = nbins;
-    for (size_t i = 0; i < nbins; i++) {
-        out->bins[i].min = bins[i].min;
-        out->bins[i].max = bins[i].max;
-        out->bins[i].target = bins[i].p;
-    }
-    free(bins);
+    size_t nbins = out->nbins;
 
     size_t n = packing->count;
     double sum_R2 = 0.0, sum_r2 = 0.0, sum_r = 0.0;
@@ -62,7 +83,7 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
             out->r_min = d->r;
         if (i == 0 || d->r > out->r_max)
             out->r_max = d->r;
-        long b = find_bin(out->bins, nbins, d->r);
+        long b = gp_bin_table_find(out->bins, nbins, d->r);
         if (b >= 0)
             out->bins[b].count++;
     }
@@ -70,14 +91,10 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
     out->grain_fraction = M_PI * sum_r2 / out->domain_area;
     out->r_mean = n ? sum_r / (double)n : 0.0;
 
+    gp_bin_table_finish(out->bins, nbins, n, &out->max_abs_z);
     int used = 0;
     for (size_t i = 0; i < nbins; i++) {
-        gp_bin_stat *b = &out->bins[i];
-        b->achieved = n ? (double)b->count / (double)n : 0.0;
-        double se = n ? sqrt(b->target * (1.0 - b->target) / (double)n) : 0.0;
-        b->z = se > 0.0 ? (b->achieved - b->target) / se : 0.0;
-        if (fabs(b->z) > out->max_abs_z)
-            out->max_abs_z = fabs(b->z);
+        const gp_bin_stat *b = &out->bins[i];
         if (b->target > 0.0 && n) {
             double expected = b->target * (double)n;
             double diff = (double)b->count - expected;

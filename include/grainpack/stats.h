@@ -6,6 +6,7 @@
 
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
+#include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
 
 #ifdef __cplusplus
@@ -41,6 +42,46 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
                           const gp_packing *packing, gp_pack_stats *out);
 
 void gp_pack_stats_free(gp_pack_stats *stats);
+
+/* Bins of the cell-area histogram, over [min, max] of the areas. */
+#define GP_CELL_AREA_BINS 10
+
+/* What the Laguerre stage made (SPEC §5): the cells, their sizes and neighbours, the
+ * grain-boundary band, and how the cells' equivalent radii compare with the target law. */
+typedef struct gp_cell_stats {
+    size_t count;
+    double area_min, area_max, area_mean;  /* of the (shrunk) cells */
+    size_t area_histogram[GP_CELL_AREA_BINS];
+    double neighbours_mean;
+    size_t max_neighbours;
+    size_t *neighbour_histogram; /* owned; max_neighbours + 1 entries: cells with k neighbours */
+    double band_fraction;    /* 1 - sum of cell areas / domain area: the grain-boundary band */
+    double tiling_error;     /* (sum of unshrunk cell areas - domain area) / domain area */
+    double req_min, req_max, req_mean; /* equivalent radius sqrt(area / pi) of the cells */
+    double req_ratio_mean;   /* mean of r_eq / r over the grains */
+    size_t nbins;
+    gp_bin_stat *req_bins;   /* owned: the equivalent radii against the target law's bins */
+    size_t req_outside;      /* equivalent radii in none of the bins */
+    double req_max_abs_z;
+} gp_cell_stats;
+
+/* Computes the statistics of `cells` (one per disk of `disks`) in `domain` against
+ * `dist`. Returns 0 or GP_ENOMEM; on success `out` owns its arrays (free with
+ * gp_cell_stats_free). */
+int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
+                          const gp_disk *disks, const gp_cells *cells, gp_cell_stats *out);
+
+void gp_cell_stats_free(gp_cell_stats *stats);
+
+/* The achieved-versus-target table of `dist`: its report bins (gp_distribution_report_bins)
+ * with zero counts. Returns 0 or GP_ENOMEM; *bins is the caller's to free. */
+int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **bins, size_t *nbins);
+
+/* The bin holding r among bins sorted by min, or -1 when r lies in none of them. */
+long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
+
+/* Fills `achieved` and `z` of every bin from its count out of n values, and *max_abs_z. */
+void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
 
 /* The upper tail P(X >= x) of a chi-square law with dof degrees of freedom (dof >= 1). */
 double gp_chi2_upper_tail(double x, int dof);

@@ -1,0 +1,368 @@
+/* laguerre.c - power cells clipped to the domain and shrunk (SPEC §5). A cell is built by
+ * cutting the domain rectangle with the radical half-plane of each triangulation neighbour
+ * (Sutherland-Hodgman on a convex polygon), in coordinates relative to the centre so that
+ * every vertex is accurate to a few ulps of the grain's size wherever the grain lies. */
+#include "grainpack/laguerre.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Cells between two progress reports and cancel checks: a few milliseconds of work. */
+#define CELLS_PER_REPORT 16384
+
+/* Edge labels of a polygon under construction: a neighbour id (>= 0) or a wall. */
+#define WALL_BOTTOM (-1)
+#define WALL_RIGHT (-2)
+#define WALL_TOP (-3)
+#define WALL_LEFT (-4)
+
+const char *gp_shrink_name(gp_shrink shrink)
+{
+    switch (shrink) {
+    case GP_SHRINK_NONE: return "none";
+    case GP_SHRINK_HOMOTHETIC: return "homothetic";
+    case GP_SHRINK_OFFSET: return "offset";
+    }
+    return "?";
+}
+
+double gp_polygon_area(const double *xy, size_t n)
+{
+    if (n < 3)
+        return 0.0;
+    /* relative to the first vertex: no cancellation between large coordinates */
+    double sum = 0.0;
+    for (size_t k = 1; k + 1 < n; k++) {
+        double ax = xy[2 * k] - xy[0], ay = xy[2 * k + 1] - xy[1];
+        double bx = xy[2 * k + 2] - xy[0], by = xy[2 * k + 3] - xy[1];
+        sum += ax * by - ay * bx;
+    }
+    return 0.5 * sum;
+}
+
+/* A convex polygon relative to the centre, with the label of the edge that starts at
+ * each vertex. Two of them are swapped by each cut. */
+typedef struct polygon {
+    double *u; /* x, y interleaved */
+    int32_t *label;
+    size_t n, cap;
+} polygon;
+
+static int polygon_reserve(polygon *p, size_t cap)
+{
+    if (cap <= p->cap)
+        return 0;
+    double *u = realloc(p->u, 2 * cap * sizeof *u);
+    if (!u)
+        return GP_ENOMEM;
+    p->u = u;
+    int32_t *label = realloc(p->label, cap * sizeof *label);
+    if (!label)
+        return GP_ENOMEM;
+    p->label = label;
+    p->cap = cap;
+    return 0;
+}
+
+static void polygon_push(polygon *p, double x, double y, int32_t label)
+{
+    p->u[2 * p->n] = x;
+    p->u[2 * p->n + 1] = y;
+    p->label[p->n++] = label;
+}
+
+/* out = in cut by the half-plane u.(nx, ny) <= c, the new edge labelled `label`.
+ * out must have room for in->n + 1 vertices (a convex polygon gains at most one). */
+static void cut(const polygon *in, double nx, double ny, double c, int32_t label, polygon *out)
+{
+    out->n = 0;
+    for (size_t k = 0; k < in->n; k++) {
+        size_t l = k + 1 < in->n ? k + 1 : 0;
+        double ax = in->u[2 * k], ay = in->u[2 * k + 1], bx = in->u[2 * l], by = in->u[2 * l + 1];
+        double da = ax * nx + ay * ny - c, db = bx * nx + by * ny - c;
+        int a_in = da <= 0.0, b_in = db <= 0.0;
+        if (a_in)
+            polygon_push(out, ax, ay, in->label[k]);
+        if (a_in == b_in)
+            continue;
+        /* leaving, the new edge starts at the crossing; entering, the cut edge resumes
+         * there. A vertex exactly on the line is the crossing itself: no duplicate. */
+        double t = da / (da - db);
+        if (a_in && da == 0.0)
+            out->label[out->n - 1] = label;
+        else if (a_in)
+            polygon_push(out, ax + t * (bx - ax), ay + t * (by - ay), label);
+        else if (db < 0.0)
+            polygon_push(out, ax + t * (bx - ax), ay + t * (by - ay), in->label[k]);
+    }
+}
+
+/* The radical half-plane of p against neighbour q, relative to p: the points u with
+ * |u|^2 - R_p^2 <= |u - n|^2 - R_q^2, i.e. u.n <= (|n|^2 + R_p^2 - R_q^2) / 2 with
+ * n = q - p; *len gets |n|. */
+static double radical(const gp_disk *p, const gp_disk *q, double *nx, double *ny, double *len)
+{
+    *nx = q->x - p->x;
+    *ny = q->y - p->y;
+    double n2 = *nx * *nx + *ny * *ny;
+    *len = sqrt(n2);
+    return 0.5 * (n2 + p->R * p->R - q->R * q->R);
+}
+
+/* The wall labelled `wall` as a half-plane relative to p, moved inward by `inset`. */
+static void wall_half_plane(const gp_domain *dom, const gp_disk *p, int32_t wall, double inset,
+                            double *nx, double *ny, double *c)
+{
+    switch (wall) {
+    case WALL_BOTTOM: *nx = 0.0; *ny = -1.0; *c = p->y - inset; break;
+    case WALL_RIGHT: *nx = 1.0; *ny = 0.0; *c = dom->width - p->x - inset; break;
+    case WALL_TOP: *nx = 0.0; *ny = 1.0; *c = dom->height - p->y - inset; break;
+    default: *nx = -1.0; *ny = 0.0; *c = p->x - inset; break;
+    }
+}
+
+/* Everything one run works with. */
+typedef struct builder {
+    const gp_domain *domain;
+    const gp_disk *disks;
+    const gp_laguerre_params *params;
+    const gp_rt *rt;
+    polygon a, b;    /* the cell, and the scratch the cuts swap with it */
+    int32_t *labels; /* the edge labels of the unshrunk cell, while it is shrunk */
+    size_t labels_cap;
+    int32_t *ring;
+    size_t ring_cap;
+    gp_cells *out;
+    size_t nxy, xy_cap, nnb, nb_cap; /* used and allocated entries of out->xy / neighbours */
+} builder;
+
+/* `array` (capacity *cap elements of `size` bytes) with room for `need` elements:
+ * itself, or a larger copy (the capacity doubled until it fits), or NULL when out of
+ * memory (the array is then untouched). */
+static void *grow(void *array, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return array;
+    size_t cap2 = *cap ? *cap : 64;
+    while (cap2 < need)
+        cap2 *= 2;
+    void *grown = realloc(array, cap2 * size);
+    if (grown)
+        *cap = cap2;
+    return grown;
+}
+
+/* The power cell of disk i clipped to the domain, into bd->a; its ring in bd->ring.
+ * *holds_centre is cleared when the centre is not strictly inside every half-plane: a
+ * packing disk lies in its own power cell unless it overlaps another disk (for disks
+ * apart, c = (d^2 + R_p^2 - R_q^2) / 2 >= R_p (R_p + R_q) > 0) or leaves the domain. */
+static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
+{
+    const gp_disk *p = &bd->disks[i];
+    int hull;
+    for (;;) {
+        *degree = gp_rt_ring(bd->rt, i, bd->ring, bd->ring_cap, &hull);
+        if (*degree <= bd->ring_cap)
+            break;
+        int32_t *ring = grow(bd->ring, &bd->ring_cap, *degree, sizeof *ring);
+        if (!ring)
+            return GP_ENOMEM;
+        bd->ring = ring;
+    }
+    /* the cell has at most the four walls and one edge per neighbour (m <= degree + 4);
+     * while it is shrunk, at most its m edges and their m moved copies */
+    size_t m = *degree + 4;
+    int32_t *labels = grow(bd->labels, &bd->labels_cap, m, sizeof *labels);
+    if (!labels)
+        return GP_ENOMEM;
+    bd->labels = labels;
+    if (polygon_reserve(&bd->a, 2 * m + 1) || polygon_reserve(&bd->b, 2 * m + 1))
+        return GP_ENOMEM;
+    double W = bd->domain->width, H = bd->domain->height;
+    bd->a.n = 0;
+    polygon_push(&bd->a, -p->x, -p->y, WALL_BOTTOM);
+    polygon_push(&bd->a, W - p->x, -p->y, WALL_RIGHT);
+    polygon_push(&bd->a, W - p->x, H - p->y, WALL_TOP);
+    polygon_push(&bd->a, -p->x, H - p->y, WALL_LEFT);
+    *holds_centre = p->x > 0.0 && p->y > 0.0 && p->x < W && p->y < H;
+    for (size_t k = 0; k < *degree && bd->a.n > 0; k++) {
+        double nx, ny, len, c = radical(p, &bd->disks[bd->ring[k]], &nx, &ny, &len);
+        *holds_centre &= c > 0.0;
+        cut(&bd->a, nx, ny, c, bd->ring[k], &bd->b);
+        polygon swap = bd->a;
+        bd->a = bd->b;
+        bd->b = swap;
+    }
+    return 0;
+}
+
+/* Appends the neighbours across the edges of bd->a longer than the tolerance. */
+static int record_neighbours(builder *bd, const gp_disk *p)
+{
+    const polygon *a = &bd->a;
+    int32_t *nb = grow(bd->out->neighbours, &bd->nb_cap, bd->nnb + a->n, sizeof *nb);
+    if (!nb)
+        return GP_ENOMEM;
+    bd->out->neighbours = nb;
+    double min_len = GP_LAGUERRE_EDGE_RTOL * p->R;
+    for (size_t k = 0; k < a->n; k++) {
+        size_t l = k + 1 < a->n ? k + 1 : 0;
+        double ex = a->u[2 * l] - a->u[2 * k], ey = a->u[2 * l + 1] - a->u[2 * k + 1];
+        if (a->label[k] >= 0 && ex * ex + ey * ey > min_len * min_len)
+            bd->out->neighbours[bd->nnb++] = a->label[k];
+    }
+    return 0;
+}
+
+/* Shrinks the cell in bd->a (SPEC §5). */
+static void shrink(builder *bd, const gp_disk *p)
+{
+    polygon *a = &bd->a;
+    if (bd->params->shrink == GP_SHRINK_HOMOTHETIC) {
+        double s = p->r / p->R;
+        for (size_t k = 0; k < 2 * a->n; k++)
+            a->u[k] *= s;
+        return;
+    }
+    if (bd->params->shrink != GP_SHRINK_OFFSET)
+        return;
+    /* the erosion of a convex polygon by j is the intersection of its edges' half-planes
+     * moved inward by j; the cuts use the edges of the unshrunk cell */
+    double j = p->R - p->r;
+    size_t m = a->n;
+    int32_t *labels = bd->labels;
+    memcpy(labels, a->label, m * sizeof *labels);
+    for (size_t k = 0; k < m && a->n > 0; k++) {
+        double nx, ny, c, len;
+        if (labels[k] >= 0) {
+            c = radical(p, &bd->disks[labels[k]], &nx, &ny, &len);
+            c -= j * len;
+        } else {
+            wall_half_plane(bd->domain, p, labels[k], bd->params->flush_boundary ? 0.0 : j, &nx, &ny, &c);
+        }
+        cut(a, nx, ny, c, labels[k], &bd->b);
+        polygon swap = *a;
+        *a = bd->b;
+        bd->b = swap;
+    }
+}
+
+static int build_cell(builder *bd, int32_t i, gp_error *err)
+{
+    const gp_disk *p = &bd->disks[i];
+    size_t degree;
+    int holds_centre;
+    if (power_cell(bd, i, &degree, &holds_centre))
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cell of disk %d", i);
+    if (!holds_centre || bd->a.n < 3)
+        return gp_error_set(err, GP_EGEOM, NULL,
+                            "disk %d at (%.17g, %.17g) is outside its own power cell: it overlaps "
+                            "another disk or lies outside the domain",
+                            i, p->x, p->y);
+    bd->out->power_area_sum += gp_polygon_area(bd->a.u, bd->a.n);
+    if (record_neighbours(bd, p))
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for neighbours");
+    bd->out->nstart[i + 1] = bd->nnb;
+    shrink(bd, p);
+    gp_cells *out = bd->out;
+    double *xy = grow(out->xy, &bd->xy_cap, 2 * (bd->nxy + bd->a.n), sizeof *xy);
+    if (!xy)
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for cell vertices");
+    out->xy = xy;
+    for (size_t k = 0; k < bd->a.n; k++) {
+        out->xy[2 * bd->nxy] = p->x + bd->a.u[2 * k];
+        out->xy[2 * bd->nxy + 1] = p->y + bd->a.u[2 * k + 1];
+        bd->nxy++;
+    }
+    out->start[i + 1] = bd->nxy;
+    out->area[i] = gp_polygon_area(bd->a.u, bd->a.n);
+    return 0;
+}
+
+/* Keeps j among the neighbours of i only if i is among those of j: an edge whose length
+ * is within rounding of the tolerance could otherwise count on one side only. */
+static void symmetrize_neighbours(gp_cells *c)
+{
+    size_t w = 0;
+    for (size_t i = 0; i < c->count; i++) {
+        size_t begin = c->nstart[i], end = c->nstart[i + 1];
+        c->nstart[i] = w;
+        for (size_t k = begin; k < end; k++) {
+            int32_t j = c->neighbours[k];
+            int mutual = 0;
+            for (size_t m = c->nstart[j]; m < c->nstart[j + 1] && !mutual; m++)
+                mutual = c->neighbours[m] == (int32_t)i;
+            /* the lists of j < i are already compacted; their entries are final */
+            if (mutual)
+                c->neighbours[w++] = j;
+        }
+    }
+    c->nstart[c->count] = w;
+}
+
+int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
+                const gp_laguerre_params *params, const gp_progress *progress,
+                gp_cells *out, gp_error *err)
+{
+    memset(out, 0, sizeof *out);
+    builder bd;
+    memset(&bd, 0, sizeof bd);
+    bd.domain = domain;
+    bd.disks = disks;
+    bd.params = params;
+    bd.rt = rt;
+    bd.out = out;
+    out->count = n;
+    out->shrink = params->shrink;
+    out->start = calloc(n + 1, sizeof *out->start);
+    out->nstart = calloc(n + 1, sizeof *out->nstart);
+    out->area = malloc((n ? n : 1) * sizeof *out->area);
+    /* room for the usual: six neighbours and seven vertices a cell; grown if needed */
+    bd.ring_cap = 64;
+    bd.ring = malloc(bd.ring_cap * sizeof *bd.ring);
+    bd.xy_cap = 16 * n + 16;
+    out->xy = malloc(bd.xy_cap * sizeof *out->xy);
+    bd.nb_cap = 7 * n + 16;
+    out->neighbours = malloc(bd.nb_cap * sizeof *out->neighbours);
+    int rc = 0;
+    if (!out->start || !out->nstart || !out->area || !bd.ring || !out->xy || !out->neighbours) {
+        rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells of %zu disks", n);
+        goto done;
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (progress && i % CELLS_PER_REPORT == CELLS_PER_REPORT - 1) {
+            if (progress->cancel && atomic_load_explicit(progress->cancel, memory_order_relaxed)) {
+                rc = gp_error_set(err, GP_ECANCELED, NULL, "laguerre cells canceled");
+                goto done;
+            }
+            if (progress->report)
+                progress->report(progress->ctx, "laguerre", (double)i / (double)n);
+        }
+        if ((rc = build_cell(&bd, (int32_t)i, err)))
+            goto done;
+    }
+    symmetrize_neighbours(out);
+    if (progress && progress->report)
+        progress->report(progress->ctx, "laguerre", 1.0);
+done:
+    free(bd.a.u);
+    free(bd.a.label);
+    free(bd.b.u);
+    free(bd.b.label);
+    free(bd.ring);
+    free(bd.labels);
+    if (rc)
+        gp_cells_free(out);
+    return rc;
+}
+
+void gp_cells_free(gp_cells *cells)
+{
+    free(cells->start);
+    free(cells->xy);
+    free(cells->nstart);
+    free(cells->neighbours);
+    free(cells->area);
+    memset(cells, 0, sizeof *cells);
+}
