@@ -14,13 +14,15 @@ enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2, EXIT_BAD_SPEC = 3 };
 
 static void usage(FILE *out)
 {
-    fputs("usage: grainpack run SPEC.json [--format json|csv|svg] [-o FILE] [--max-disks N]\n"
+    fputs("usage: grainpack run SPEC.json [--format json|csv|svg|vtk] [-o FILE] [--max-disks N]\n"
           "       grainpack validate SPEC.json [--max-disks N]\n"
           "       grainpack --help | --version\n"
           "\n"
-          "run       packs the domain the spec describes and writes the result (default\n"
-          "          JSON with statistics, to standard output). SPEC.json is the job spec,\n"
-          "          either {\"inputs\": {...}} or the bare inputs object; '-' reads stdin.\n"
+          "run       packs the domain the spec describes, balances it and builds its\n"
+          "          Laguerre cells when the spec asks (\"balance\", \"laguerre\"), and writes\n"
+          "          the result (default JSON with statistics, to standard output). SPEC.json\n"
+          "          is the job spec, either {\"inputs\": {...}} or the bare inputs object;\n"
+          "          '-' reads stdin.\n"
           "validate  checks a spec and prints the expected number of disks.\n"
           "\n"
           "--max-disks N  refuse specs expected to need more than N disks (default 20000000)\n"
@@ -84,9 +86,19 @@ static int run(const char *spec_path, gp_format format, const char *out_path, si
         gp_spec_free(&spec);
         return EXIT_FAILED;
     }
-    if (tty)
+    if (tty) {
         fprintf(stderr, "grainpack: %zu disks, packing density %.4f, %.1f ms\n", result.stats.count,
                 result.stats.packing_density, 1e3 * gp_result_stage_seconds(&result, "pack"));
+        if (result.has_balance)
+            fprintf(stderr, "grainpack: %s: F_max %.4f -> %.4f, mean F %.4f -> %.4f, %u sweeps, %.1f ms\n",
+                    gp_balance_method_name(result.balance.method), result.balance.before.max,
+                    result.balance.after.max, result.balance.before.mean, result.balance.after.mean,
+                    result.balance.sweeps, 1e3 * gp_result_stage_seconds(&result, "balance"));
+        if (result.has_cells)
+            fprintf(stderr, "grainpack: %zu cells (%s), boundary band %.4f of the domain, %.1f ms\n",
+                    result.cell_stats.count, gp_shrink_name(result.cells.shrink),
+                    result.cell_stats.band_fraction, 1e3 * gp_result_stage_seconds(&result, "laguerre"));
+    }
 
     FILE *out = out_path ? fopen(out_path, "wb") : stdout;
     if (!out) {
@@ -160,7 +172,7 @@ int main(int argc, char **argv)
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         if ((strcmp(arg, "--format") == 0 || strcmp(arg, "-f") == 0) && value) {
             if (gp_format_parse(value, &format)) {
-                fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv or svg)\n", value);
+                fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg or vtk)\n", value);
                 return EXIT_USAGE;
             }
             i++;

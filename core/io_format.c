@@ -9,6 +9,8 @@ static const struct {
     [GP_FORMAT_JSON] = {"json", "application/json"},
     [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8"},
     [GP_FORMAT_SVG] = {"svg", "image/svg+xml"},
+    /* legacy VTK has no registered media type; this is the one in common use */
+    [GP_FORMAT_VTK] = {"vtk", "application/x-vtk"},
 };
 
 int gp_format_parse(const char *name, gp_format *out)
@@ -43,6 +45,7 @@ int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_r
     case GP_FORMAT_JSON: return gp_write_json(out, spec, result);
     case GP_FORMAT_CSV: return gp_write_csv(out, result);
     case GP_FORMAT_SVG: return gp_write_svg(out, spec, result);
+    case GP_FORMAT_VTK: return gp_write_vtk(out, spec, result);
     }
     return GP_EINVAL;
 }

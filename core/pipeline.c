@@ -1,4 +1,5 @@
-/* pipeline.c - spec -> packing -> statistics, timing each stage. */
+/* pipeline.c - spec -> packing -> (balance, Laguerre cells) -> statistics, timing each
+ * stage. */
 #include "grainpack/pipeline.h"
 
 #include <string.h>
@@ -29,14 +30,45 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
         .max_disks = max_disks,
         .level_band = spec->level_band,
     };
+    gp_rt *rt = NULL;
+    gp_packing *pk = &result->packing;
     double t0 = now_seconds();
-    int rc = gp_pack(&params, progress, &result->packing, err);
+    int rc = gp_pack(&params, progress, pk, err);
     if (rc)
         goto fail;
     record(result, "pack", t0);
 
+    if (spec->balance_enabled || spec->laguerre_enabled) {
+        /* one triangulation serves both stages: balancing keeps it up to date */
+        t0 = now_seconds();
+        if ((rc = gp_rt_build(pk->disks, pk->count, &rt, err)))
+            goto fail;
+        record(result, "triangulation", t0);
+    }
+    if (spec->balance_enabled) {
+        t0 = now_seconds();
+        if ((rc = gp_balance(&spec->domain, pk->disks, pk->count, rt, &spec->balance, progress,
+                             &result->balance, err)))
+            goto fail;
+        result->has_balance = 1;
+        record(result, "balance", t0);
+    }
+    if (spec->laguerre_enabled) {
+        t0 = now_seconds();
+        if ((rc = gp_laguerre(&spec->domain, pk->disks, pk->count, rt, &spec->laguerre, progress,
+                              &result->cells, err)))
+            goto fail;
+        result->has_cells = 1;
+        record(result, "laguerre", t0);
+    }
+    gp_rt_free(rt);
+    rt = NULL;
+
     t0 = now_seconds();
-    rc = gp_pack_stats_compute(&spec->domain, &spec->dist, &result->packing, &result->stats);
+    rc = gp_pack_stats_compute(&spec->domain, &spec->dist, pk, &result->stats);
+    if (rc == 0 && result->has_cells)
+        rc = gp_cell_stats_compute(&spec->domain, &spec->dist, pk->disks, &result->cells,
+                                   &result->cell_stats);
     if (rc) {
         gp_error_set(err, rc, NULL, "out of memory computing statistics");
         goto fail;
@@ -45,6 +77,7 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
     return 0;
 
 fail:
+    gp_rt_free(rt);
     gp_result_free(result);
     return rc;
 }
@@ -53,6 +86,9 @@ void gp_result_free(gp_result *result)
 {
     gp_packing_free(&result->packing);
     gp_pack_stats_free(&result->stats);
+    gp_balance_result_free(&result->balance);
+    gp_cells_free(&result->cells);
+    gp_cell_stats_free(&result->cell_stats);
     memset(result, 0, sizeof *result);
 }
 

@@ -329,6 +329,108 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
     return 0;
 }
 
+/* Reads an optional boolean member; *out keeps its value when the member is absent. */
+static int get_bool(validator *v, const json_t *obj, const char *base, const char *key, int *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    if (!value)
+        return 0;
+    if (!json_is_boolean(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be true or false, got %s", type_phrase(value));
+    *out = json_is_true(value);
+    return 0;
+}
+
+static int parse_balance(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+{
+    char ptr[GP_ERROR_POINTER_MAX], member[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "balance", 0, &obj, ptr);
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"method", "max_iterations", "max_step", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "method, max_iterations, max_step")))
+        return rc;
+    static const char *const methods[] = {"none", "laplacian", "relocation", NULL};
+    int method;
+    if ((rc = get_choice(v, obj, ptr, "method", methods, "none, laplacian, relocation", &method)))
+        return rc;
+    spec->balance_enabled = 1;
+    spec->balance.method = (gp_balance_method)method;
+    spec->balance.max_iterations = GP_BALANCE_DEFAULT_MAX_ITERATIONS;
+    spec->balance.max_step = GP_BALANCE_DEFAULT_MAX_STEP;
+    spec->balance.update = GP_RT_UPDATE_FLIPS;
+    const json_t *value = json_object_get(obj, "max_iterations");
+    if (value) {
+        pointer_key(member, ptr, "max_iterations");
+        if (!json_is_integer(value))
+            return gp_error_set(v->err, GP_EINVAL, member, "must be an integer from 1 to %d, got %s",
+                                GP_SPEC_MAX_BALANCE_ITERATIONS, type_phrase(value));
+        json_int_t n = json_integer_value(value);
+        if (n < 1 || n > GP_SPEC_MAX_BALANCE_ITERATIONS)
+            return gp_error_set(v->err, GP_EINVAL, member, "must be an integer from 1 to %d, got %lld",
+                                GP_SPEC_MAX_BALANCE_ITERATIONS, (long long)n);
+        spec->balance.max_iterations = (uint32_t)n;
+    }
+    if (json_object_get(obj, "max_step")) {
+        /* the steps tried go down by 0.05 to 0.05 (SPEC §4.4): a smaller first step tries none */
+        if ((rc = get_number(v, obj, ptr, "max_step", 0.05, 1, &spec->balance.max_step)))
+            return rc;
+        if (spec->balance.max_step > 1.0) {
+            pointer_key(member, ptr, "max_step");
+            return gp_error_set(v->err, GP_EINVAL, member, "must be <= 1 (the whole way to the target), got %.17g",
+                                spec->balance.max_step);
+        }
+    }
+    return 0;
+}
+
+static int parse_laguerre(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "laguerre", 0, &obj, ptr);
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"shrink", "flush_boundary", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "shrink, flush_boundary")))
+        return rc;
+    static const char *const shrinks[] = {"none", "homothetic", "offset", NULL};
+    int shrink;
+    if ((rc = get_choice(v, obj, ptr, "shrink", shrinks, "homothetic, offset, none", &shrink)))
+        return rc;
+    spec->laguerre_enabled = 1;
+    spec->laguerre.shrink = (gp_shrink)shrink;
+    return get_bool(v, obj, ptr, "flush_boundary", &spec->laguerre.flush_boundary);
+}
+
+static int parse_picture(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+{
+    char ptr[GP_ERROR_POINTER_MAX], color_ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    spec->picture_color = spec->balance_enabled ? GP_PICTURE_COLOR_QUALITY : GP_PICTURE_COLOR_RADIUS;
+    int rc = get_object(v, inputs, base, "picture", 0, &obj, ptr);
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"color", "disks", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "color, disks")))
+        return rc;
+    if (json_object_get(obj, "color")) {
+        static const char *const colors[] = {"radius", "quality", NULL};
+        int color;
+        if ((rc = get_choice(v, obj, ptr, "color", colors, "radius, quality", &color)))
+            return rc;
+        spec->picture_color = (gp_picture_color)color;
+        pointer_key(color_ptr, ptr, "color");
+        if (spec->picture_color == GP_PICTURE_COLOR_QUALITY && !spec->balance_enabled)
+            return gp_error_set(v->err, GP_EINVAL, color_ptr,
+                                "\"quality\" needs the balance stage: add \"balance\": {\"method\": ...}");
+    }
+    return get_bool(v, obj, ptr, "disks", &spec->picture_disks);
+}
+
 static int parse_seed(validator *v, const json_t *inputs, const char *base, uint64_t *seed)
 {
     char ptr[GP_ERROR_POINTER_MAX];
@@ -407,14 +509,18 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         inputs = wrapped;
         base = "/inputs";
     }
-    static const char *const members[] = {"domain", "distribution", "joint", "seed", "front", NULL};
+    static const char *const members[] = {"domain", "distribution", "joint", "seed", "front",
+                                          "balance", "laguerre", "picture", NULL};
     int rc;
-    if ((rc = check_members(v, inputs, base, members, "domain, distribution, joint, seed, front")) ||
+    if ((rc = check_members(v, inputs, base, members,
+                            "domain, distribution, joint, seed, front, balance, laguerre, picture")) ||
         (rc = parse_domain(v, inputs, base, &spec->domain)) ||
         (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = parse_seed(v, inputs, base, &spec->seed)) ||
-        (rc = parse_front(v, inputs, base, &spec->level_band)) || (rc = check_whole(v, base, spec)))
+        (rc = parse_front(v, inputs, base, &spec->level_band)) ||
+        (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
+        (rc = parse_picture(v, inputs, base, spec)) || (rc = check_whole(v, base, spec)))
         return rc;
     if (gp_distribution_prepare(&spec->dist))
         return gp_error_set(v->err, GP_ENOMEM, "", "out of memory");

@@ -22,6 +22,21 @@ count=$("$bin" run "$examples/iron.json" | sed -n 's/.*"count":\([0-9]*\),"domai
 "$bin" run "$examples/fixed.json" -f svg -o "$tmp/fixed.svg" || fail "run svg exited $?"
 grep -q '</svg>' "$tmp/fixed.svg" || fail "svg is not closed"
 
+# balance and Laguerre cells from the spec; VTK polydata with one polygon per grain
+python3 - "$examples/variable.json" > "$tmp/staged.json" <<'PY' 2>/dev/null || sed 's/"seed": 1/"seed": 1, "balance": {"method": "relocation"}, "laguerre": {"shrink": "offset"}/' "$examples/variable.json" > "$tmp/staged.json"
+import json, sys
+spec = json.load(open(sys.argv[1]))
+spec["inputs"]["balance"] = {"method": "relocation"}
+spec["inputs"]["laguerre"] = {"shrink": "offset"}
+print(json.dumps(spec))
+PY
+"$bin" run "$tmp/staged.json" -f vtk -o "$tmp/cells.vtk" || fail "run vtk exited $?"
+head -1 "$tmp/cells.vtk" | grep -q "# vtk DataFile Version 3.0" || fail "vtk header is '$(head -1 "$tmp/cells.vtk")'"
+polygons=$(sed -n 's/^POLYGONS \([0-9]*\) .*/\1/p' "$tmp/cells.vtk")
+"$bin" run "$tmp/staged.json" -f csv -o "$tmp/staged.csv" || fail "run staged csv exited $?"
+[ "$polygons" = "$(($(wc -l < "$tmp/staged.csv") - 1))" ] || fail "vtk has '$polygons' polygons for $(($(wc -l < "$tmp/staged.csv") - 1)) grains"
+"$bin" run "$tmp/staged.json" | grep -q '"balance":{"method":"relocation"' || fail "json lacks the balance statistics"
+
 # the bare inputs object on stdin works as well as the whole request
 python3 - "$examples/iron.json" > "$tmp/bare.json" <<'PY' 2>/dev/null || jq '.inputs' "$examples/iron.json" > "$tmp/bare.json"
 import json, sys
@@ -55,7 +70,8 @@ grep -q "line 2" "$tmp/err" || fail "broken json message: $(cat "$tmp/err")"
 grep -q "more than the limit of 1000" "$tmp/err" || fail "cap message: $(cat "$tmp/err")"
 
 # usage errors: exit 2
-"$bin" run "$examples/iron.json" --format xml 2> /dev/null; [ $? -eq 2 ] || fail "unknown format"
+"$bin" run "$examples/iron.json" --format xml 2> "$tmp/err"; [ $? -eq 2 ] || fail "unknown format"
+grep -q "expected json, csv, svg or vtk" "$tmp/err" || fail "unknown format message: $(cat "$tmp/err")"
 "$bin" frobnicate 2> /dev/null; [ $? -eq 2 ] || fail "unknown command"
 "$bin" run 2> /dev/null; [ $? -eq 2 ] || fail "missing spec"
 "$bin" run "$examples/iron.json" --max-disks -5 2> /dev/null; [ $? -eq 2 ] || fail "negative cap"

@@ -68,7 +68,7 @@ static void test_same_seed_same_bytes_other_seed_other_bytes(void)
     spec.seed = 2;
     CHECK(gp_pipeline_run(&spec, 0, NULL, &c, &err) == 0);
     spec.seed = 1;
-    for (int f = GP_FORMAT_JSON; f <= GP_FORMAT_SVG; f++) {
+    for (int f = GP_FORMAT_JSON; f <= GP_FORMAT_VTK; f++) {
         size_t la, lb, lc;
         char *ta = render((gp_format)f, &spec, &a, &la), *tb = render((gp_format)f, &spec, &b, &lb);
         spec.seed = 2;
@@ -161,13 +161,104 @@ static void test_svg_draws_one_circle_per_grain_with_legend(void)
     gp_spec_free(&spec);
 }
 
+/* Runs the iron case balanced and with Laguerre cells. */
+static void run_iron_with_stages(gp_spec *spec, gp_result *r, gp_shrink shrink)
+{
+    load_example("iron", spec);
+    spec->balance_enabled = 1;
+    spec->balance = (gp_balance_params){GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_FLIPS};
+    spec->picture_color = GP_PICTURE_COLOR_QUALITY;
+    spec->laguerre_enabled = shrink != (gp_shrink)-1;
+    spec->laguerre = (gp_laguerre_params){shrink, 0};
+    gp_error err;
+    CHECK_MSG(gp_pipeline_run(spec, 0, NULL, r, &err) == 0, "%s", err.message);
+}
+
+static size_t count(const char *text, const char *what)
+{
+    size_t n = 0;
+    for (const char *p = text; (p = strstr(p, what)); p++)
+        n++;
+    return n;
+}
+
+static void test_svg_colours_by_F_with_its_legend(void)
+{
+    gp_spec spec;
+    gp_result r;
+    run_iron_with_stages(&spec, &r, (gp_shrink)-1);
+    size_t len;
+    char *text = render(GP_FORMAT_SVG, &spec, &r, &len);
+    CHECK(count(text, "<circle") == r.packing.count);
+    CHECK(strstr(text, "balance criterion F") != NULL && strstr(text, "F_max") != NULL);
+    /* the grey group holds exactly the grains without F */
+    size_t undefined = 0;
+    for (size_t i = 0; i < r.packing.count; i++)
+        undefined += isnan(r.balance.F[i]);
+    char *grey = strstr(text, "<g fill=\"#c8c8c8\"");
+    CHECK(grey != NULL && undefined > 0);
+    if (grey) {
+        char *end = strstr(grey, "</g>");
+        size_t in_grey = 0;
+        for (char *p = grey; (p = strstr(p, "<circle")) && p < end; p++)
+            in_grey++;
+        CHECK_MSG(in_grey == undefined, "%zu grey circles, %zu grains without F", in_grey, undefined);
+    }
+    free(text);
+    gp_result_free(&r);
+    gp_spec_free(&spec);
+}
+
+static void test_svg_draws_cells_on_the_band(void)
+{
+    gp_spec spec;
+    gp_result r;
+    run_iron_with_stages(&spec, &r, GP_SHRINK_OFFSET);
+    size_t len;
+    char *text = render(GP_FORMAT_SVG, &spec, &r, &len);
+    CHECK(count(text, "<polygon") == r.packing.count && count(text, "<circle") == 0);
+    CHECK(strstr(text, "fill=\"#3b3b3b\"/>") != NULL); /* the band under the cells */
+    CHECK(strstr(text, "Laguerre cells (offset shrink)") != NULL);
+    free(text);
+    spec.picture_disks = 1;
+    text = render(GP_FORMAT_SVG, &spec, &r, &len);
+    CHECK(count(text, "<circle") == r.packing.count);
+    free(text);
+    gp_result_free(&r);
+    gp_spec_free(&spec);
+}
+
+static void test_stages_are_deterministic_too(void)
+{
+    gp_spec spec;
+    gp_result a, b;
+    run_iron_with_stages(&spec, &a, GP_SHRINK_HOMOTHETIC);
+    gp_spec_free(&spec);
+    run_iron_with_stages(&spec, &b, GP_SHRINK_HOMOTHETIC);
+    for (int f = GP_FORMAT_JSON; f <= GP_FORMAT_VTK; f++) {
+        size_t la, lb;
+        char *ta = render((gp_format)f, &spec, &a, &la), *tb = render((gp_format)f, &spec, &b, &lb);
+        CHECK_MSG(la == lb && memcmp(ta, tb, la) == 0, "%s differs between two runs", gp_format_name((gp_format)f));
+        free(ta);
+        free(tb);
+    }
+    /* the timings name every stage that ran */
+    CHECK(gp_result_stage_seconds(&a, "triangulation") > 0.0 && gp_result_stage_seconds(&a, "balance") > 0.0 &&
+          gp_result_stage_seconds(&a, "laguerre") > 0.0);
+    gp_result_free(&a);
+    gp_result_free(&b);
+    gp_spec_free(&spec);
+}
+
 static void test_format_names(void)
 {
     gp_format f;
     CHECK(gp_format_parse("csv", &f) == 0 && f == GP_FORMAT_CSV);
     CHECK(gp_format_parse("svg", &f) == 0 && f == GP_FORMAT_SVG);
+    CHECK(gp_format_parse("vtk", &f) == 0 && f == GP_FORMAT_VTK);
     CHECK(gp_format_parse("xml", &f) == GP_EINVAL);
     CHECK_STR(gp_format_media_type(GP_FORMAT_SVG), "image/svg+xml");
+    CHECK_STR(gp_format_name(GP_FORMAT_VTK), "vtk");
 }
 
 int main(void)
@@ -178,5 +269,8 @@ int main(void)
     RUN(test_json_has_the_disks_and_every_statistic);
     RUN(test_svg_draws_one_circle_per_grain_with_legend);
     RUN(test_format_names);
+    RUN(test_svg_colours_by_F_with_its_legend);
+    RUN(test_svg_draws_cells_on_the_band);
+    RUN(test_stages_are_deterministic_too);
     return check_status();
 }

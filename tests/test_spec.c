@@ -118,7 +118,50 @@ static const error_case errors[] = {
      GP_EINVAL, "/joint", "non-finite"},
     {"{\"domain\":{\"width\":1e5,\"height\":1e5}," CONST "}", GP_ETOOBIG, "/domain", "more than the limit of 20000000"},
     {"{\"domain\":{\"width\":5,\"height\":5}," CONST ",\"domain\":{\"width\":6,\"height\":6}}", GP_EPARSE, "", "duplicate"},
+    {"{" DOM "," CONST ",\"balance\":[]}", GP_EINVAL, "/balance", "must be an object, got an array"},
+    {"{" DOM "," CONST ",\"balance\":{}}", GP_EINVAL, "/balance/method", "missing; expected one of none, laplacian, relocation"},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"jiggle\"}}", GP_EINVAL, "/balance/method", "got \"jiggle\""},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\",\"sweeps\":3}}", GP_EINVAL, "/balance/sweeps", "unknown field; expected one of method, max_iterations, max_step"},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\",\"max_iterations\":0}}", GP_EINVAL, "/balance/max_iterations", "from 1 to 100000, got 0"},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\",\"max_iterations\":2.5}}", GP_EINVAL, "/balance/max_iterations", "got a number"},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"laplacian\",\"max_step\":0.01}}", GP_EINVAL, "/balance/max_step", "must be >= 0.05, got 0.01"},
+    {"{" DOM "," CONST ",\"balance\":{\"method\":\"laplacian\",\"max_step\":1.5}}", GP_EINVAL, "/balance/max_step", "must be <= 1"},
+    {"{" DOM "," CONST ",\"laguerre\":{}}", GP_EINVAL, "/laguerre/shrink", "missing; expected one of homothetic, offset, none"},
+    {"{" DOM "," CONST ",\"laguerre\":{\"shrink\":\"erode\"}}", GP_EINVAL, "/laguerre/shrink", "got \"erode\""},
+    {"{" DOM "," CONST ",\"laguerre\":{\"shrink\":\"offset\",\"flush_boundary\":1}}", GP_EINVAL, "/laguerre/flush_boundary", "must be true or false, got an integer"},
+    {"{" DOM "," CONST ",\"laguerre\":{\"shrink\":\"offset\",\"shrunk\":true}}", GP_EINVAL, "/laguerre/shrunk", "unknown field"},
+    {"{" DOM "," CONST ",\"picture\":{\"color\":\"quality\"}}", GP_EINVAL, "/picture/color", "needs the balance stage"},
+    {"{" DOM "," CONST ",\"picture\":{\"color\":\"blue\"}}", GP_EINVAL, "/picture/color", "must be one of radius, quality"},
+    {"{" DOM "," CONST ",\"picture\":{\"disks\":\"yes\"}}", GP_EINVAL, "/picture/disks", "must be true or false, got a string"},
+    {"{\"inputs\":{" DOM "," CONST ",\"balance\":{\"method\":\"none\",\"max_step\":\"big\"}}}", GP_EINVAL, "/inputs/balance/max_step", "got a string"},
 };
+
+static void test_balance_laguerre_and_picture_fields(void)
+{
+    gp_spec s;
+    gp_error err;
+    /* absent: both stages off, pictures coloured by radius */
+    CHECK(parse("{" DOM "," CONST "}", &s, &err) == 0);
+    CHECK(!s.balance_enabled && !s.laguerre_enabled && s.picture_color == GP_PICTURE_COLOR_RADIUS && !s.picture_disks);
+    gp_spec_free(&s);
+    /* present: defaults filled in, pictures coloured by F once there is an F */
+    CHECK(parse("{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\"},\"laguerre\":{\"shrink\":\"homothetic\"}}", &s, &err) == 0);
+    CHECK(s.balance_enabled && s.balance.method == GP_BALANCE_RELOCATION);
+    CHECK(s.balance.max_iterations == GP_BALANCE_DEFAULT_MAX_ITERATIONS && s.balance.max_step == GP_BALANCE_DEFAULT_MAX_STEP);
+    CHECK(s.laguerre_enabled && s.laguerre.shrink == GP_SHRINK_HOMOTHETIC && !s.laguerre.flush_boundary);
+    CHECK(s.picture_color == GP_PICTURE_COLOR_QUALITY);
+    gp_spec_free(&s);
+    CHECK(parse("{" DOM "," CONST ",\"balance\":{\"method\":\"laplacian\",\"max_iterations\":7,\"max_step\":0.3},"
+                "\"laguerre\":{\"shrink\":\"offset\",\"flush_boundary\":true},\"picture\":{\"color\":\"radius\",\"disks\":true}}",
+                &s, &err) == 0);
+    CHECK(s.balance.method == GP_BALANCE_LAPLACIAN && s.balance.max_iterations == 7 && s.balance.max_step == 0.3);
+    CHECK(s.laguerre.shrink == GP_SHRINK_OFFSET && s.laguerre.flush_boundary);
+    CHECK(s.picture_color == GP_PICTURE_COLOR_RADIUS && s.picture_disks);
+    gp_spec_free(&s);
+    CHECK(parse("{" DOM "," CONST ",\"balance\":{\"method\":\"none\"},\"laguerre\":{\"shrink\":\"none\"}}", &s, &err) == 0);
+    CHECK(s.balance_enabled && s.balance.method == GP_BALANCE_NONE && s.laguerre_enabled && s.laguerre.shrink == GP_SHRINK_NONE);
+    gp_spec_free(&s);
+}
 
 static void test_each_error_names_the_field_and_the_expectation(void)
 {
@@ -190,6 +233,7 @@ int main(void)
 {
     RUN(test_whole_request_and_bare_inputs_both_parse);
     RUN(test_defaults_seed_one_no_joint_band_zero);
+    RUN(test_balance_laguerre_and_picture_fields);
     RUN(test_each_error_names_the_field_and_the_expectation);
     RUN(test_pointers_in_a_wrapped_request_start_with_inputs);
     RUN(test_keys_are_escaped_in_pointers);

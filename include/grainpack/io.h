@@ -1,6 +1,6 @@
-/* io.h - writers for a job's result: CSV (one line per disk), JSON (disks and
- * statistics), SVG (a picture of the grains and their boundaries). Writers are
- * deterministic: the same result gives the same bytes. */
+/* io.h - writers for a job's result: CSV (one line per disk), JSON (disks, cells and
+ * statistics), SVG (a picture of the grains and their boundaries), VTK (legacy polydata
+ * for ParaView). Writers are deterministic: the same result gives the same bytes. */
 #ifndef GRAINPACK_IO_H
 #define GRAINPACK_IO_H
 
@@ -17,10 +17,11 @@ extern "C" {
 typedef enum gp_format {
     GP_FORMAT_JSON = 0,
     GP_FORMAT_CSV,
-    GP_FORMAT_SVG
+    GP_FORMAT_SVG,
+    GP_FORMAT_VTK
 } gp_format;
 
-/* Maps "json", "csv" or "svg" to a format; returns 0 or GP_EINVAL. */
+/* Maps "json", "csv", "svg" or "vtk" to a format; returns 0 or GP_EINVAL. */
 int gp_format_parse(const char *name, gp_format *out);
 const char *gp_format_name(gp_format format);
 /* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,
@@ -41,6 +42,7 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result);
 int gp_write_csv(FILE *out, const gp_result *result);
 int gp_write_json(FILE *out, const gp_spec *spec, const gp_result *result);
 int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result);
+int gp_write_vtk(FILE *out, const gp_spec *spec, const gp_result *result);
 int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result);
 
 #ifdef __cplusplus

@@ -1,9 +1,12 @@
-/* pipeline.h - one job from spec to result: pack, then statistics. The service and the
+/* pipeline.h - one job from spec to result: pack, then (when the spec asks) balance and
+ * Laguerre cells on one regular triangulation, then statistics. The service and the
  * command line call this very function. */
 #ifndef GRAINPACK_PIPELINE_H
 #define GRAINPACK_PIPELINE_H
 
+#include "grainpack/balance.h"
 #include "grainpack/error.h"
+#include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
 #include "grainpack/progress.h"
 #include "grainpack/spec.h"
@@ -17,13 +20,18 @@ extern "C" {
 
 /* Wall-clock time spent in one stage. */
 typedef struct gp_stage_time {
-    const char *stage; /* static string: "pack", "stats", ... */
+    const char *stage; /* static string: "pack", "triangulation", "balance", "laguerre", "stats" */
     double seconds;
 } gp_stage_time;
 
 typedef struct gp_result {
-    gp_packing packing;   /* owned */
+    gp_packing packing;   /* owned; balanced in place when the balance stage ran */
     gp_pack_stats stats;  /* owned */
+    int has_balance;      /* the balance stage ran: `balance` holds F and its statistics */
+    gp_balance_result balance; /* owned */
+    int has_cells;        /* the Laguerre stage ran: `cells` and `cell_stats` are set */
+    gp_cells cells;       /* owned */
+    gp_cell_stats cell_stats; /* owned */
     gp_stage_time timings[GP_MAX_STAGES];
     int ntimings;
 } gp_result;

@@ -6,10 +6,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/balance.h"
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
+#include "grainpack/laguerre.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -29,6 +31,15 @@ typedef struct gp_spec_limits {
 #define GP_SPEC_MAX_LEVEL_BAND 16
 /* Probabilities of a histogram must sum to 1 within this (SPEC §2); never renormalised. */
 #define GP_SPEC_PROBABILITY_TOL 1e-6
+/* The largest sweep cap a spec may ask balancing for: about an hour of sweeps at the
+ * largest packings the disk cap allows (bench/). */
+#define GP_SPEC_MAX_BALANCE_ITERATIONS 100000
+
+/* What the SVG picture colours grains by. */
+typedef enum gp_picture_color {
+    GP_PICTURE_COLOR_RADIUS = 0, /* the grain radius r */
+    GP_PICTURE_COLOR_QUALITY     /* the balance criterion F (needs the balance stage) */
+} gp_picture_color;
 
 typedef struct gp_spec {
     gp_domain domain;
@@ -37,6 +48,12 @@ typedef struct gp_spec {
     uint64_t seed;
     uint32_t level_band;   /* see gp_pack_params; "front": {"level_band": n} */
     double expected_disks; /* estimate used against the cap */
+    int balance_enabled;   /* the spec has "balance" (method "none" measures F only) */
+    gp_balance_params balance; /* "balance": {"method", "max_iterations", "max_step"} */
+    int laguerre_enabled;  /* the spec has "laguerre" */
+    gp_laguerre_params laguerre; /* "laguerre": {"shrink", "flush_boundary"} */
+    gp_picture_color picture_color; /* "picture": {"color"}: quality when balancing, else radius */
+    int picture_disks;     /* "picture": {"disks"}: outline the grain disks over the cells */
 } gp_spec;
 
 /* Parses and validates a job spec: either the whole execute request {"inputs": {...}}
