@@ -131,6 +131,8 @@ typedef struct builder {
     polygon a, b;    /* the cell, and the scratch the cuts swap with it */
     int32_t *labels; /* the edge labels of the unshrunk cell, while it is shrunk */
     size_t labels_cap;
+    int32_t *doubtful; /* pairs (i, j) whose shared edge is near the tolerance */
+    size_t ndoubtful, doubtful_cap;
     int32_t *ring;
     size_t ring_cap;
     gp_cells *out;
@@ -197,20 +199,34 @@ static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
     return 0;
 }
 
-/* Appends the neighbours across the edges of bd->a longer than the tolerance. */
-static int record_neighbours(builder *bd, const gp_disk *p)
+/* Appends the neighbours across the edges of bd->a longer than the tolerance, which is
+ * the same for both grains of an edge; an edge whose length is within a factor 2 of it
+ * goes to the doubtful list, for gp_laguerre to check that both cells agree on it. */
+static int record_neighbours(builder *bd, int32_t i)
 {
     const polygon *a = &bd->a;
     int32_t *nb = grow(bd->out->neighbours, &bd->nb_cap, bd->nnb + a->n, sizeof *nb);
     if (!nb)
         return GP_ENOMEM;
     bd->out->neighbours = nb;
-    double min_len = GP_LAGUERRE_EDGE_RTOL * p->R;
     for (size_t k = 0; k < a->n; k++) {
+        int32_t j = a->label[k];
+        if (j < 0)
+            continue;
         size_t l = k + 1 < a->n ? k + 1 : 0;
         double ex = a->u[2 * l] - a->u[2 * k], ey = a->u[2 * l + 1] - a->u[2 * k + 1];
-        if (a->label[k] >= 0 && ex * ex + ey * ey > min_len * min_len)
-            bd->out->neighbours[bd->nnb++] = a->label[k];
+        double len2 = ex * ex + ey * ey;
+        double t = 0.5 * GP_LAGUERRE_EDGE_RTOL * (bd->disks[i].R + bd->disks[j].R), t2 = t * t;
+        if (len2 > t2)
+            nb[bd->nnb++] = j;
+        if (len2 >= 0.25 * t2 && len2 <= 4.0 * t2) {
+            int32_t *pairs = grow(bd->doubtful, &bd->doubtful_cap, bd->ndoubtful + 2, sizeof *pairs);
+            if (!pairs)
+                return GP_ENOMEM;
+            bd->doubtful = pairs;
+            pairs[bd->ndoubtful++] = i;
+            pairs[bd->ndoubtful++] = j;
+        }
     }
     return 0;
 }
@@ -261,7 +277,7 @@ static int build_cell(builder *bd, int32_t i, gp_error *err)
                             "another disk or lies outside the domain",
                             i, p->x, p->y);
     bd->out->power_area_sum += gp_polygon_area(bd->a.u, bd->a.n);
-    if (record_neighbours(bd, p))
+    if (record_neighbours(bd, i))
         return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for neighbours");
     bd->out->nstart[i + 1] = bd->nnb;
     shrink(bd, p);
@@ -280,23 +296,39 @@ static int build_cell(builder *bd, int32_t i, gp_error *err)
     return 0;
 }
 
-/* Keeps j among the neighbours of i only if i is among those of j: an edge whose length
- * is within rounding of the tolerance could otherwise count on one side only. */
-static void symmetrize_neighbours(gp_cells *c)
+static int lists(const gp_cells *c, int32_t i, int32_t j)
 {
+    for (size_t m = c->nstart[i]; m < c->nstart[i + 1]; m++)
+        if (c->neighbours[m] == j)
+            return 1;
+    return 0;
+}
+
+/* Keeps j among the neighbours of i only if i is among those of j. The two cells compute
+ * their shared edge separately; only an edge whose length is within rounding of the
+ * tolerance (the doubtful pairs) can count on one side only. */
+static void symmetrize_neighbours(gp_cells *c, const int32_t *doubtful, size_t ndoubtful)
+{
+    int dropped = 0;
+    for (size_t d = 0; d + 1 < ndoubtful; d += 2) {
+        int32_t i = doubtful[d], j = doubtful[d + 1];
+        if (lists(c, j, i))
+            continue;
+        for (size_t m = c->nstart[i]; m < c->nstart[i + 1]; m++)
+            if (c->neighbours[m] == j) {
+                c->neighbours[m] = -1;
+                dropped = 1;
+            }
+    }
+    if (!dropped)
+        return;
     size_t w = 0;
     for (size_t i = 0; i < c->count; i++) {
         size_t begin = c->nstart[i], end = c->nstart[i + 1];
         c->nstart[i] = w;
-        for (size_t k = begin; k < end; k++) {
-            int32_t j = c->neighbours[k];
-            int mutual = 0;
-            for (size_t m = c->nstart[j]; m < c->nstart[j + 1] && !mutual; m++)
-                mutual = c->neighbours[m] == (int32_t)i;
-            /* the lists of j < i are already compacted; their entries are final */
-            if (mutual)
-                c->neighbours[w++] = j;
-        }
+        for (size_t k = begin; k < end; k++)
+            if (c->neighbours[k] >= 0)
+                c->neighbours[w++] = c->neighbours[k];
     }
     c->nstart[c->count] = w;
 }
@@ -342,7 +374,7 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
         if ((rc = build_cell(&bd, (int32_t)i, err)))
             goto done;
     }
-    symmetrize_neighbours(out);
+    symmetrize_neighbours(out, bd.doubtful, bd.ndoubtful);
     if (progress && progress->report)
         progress->report(progress->ctx, "laguerre", 1.0);
 done:
@@ -352,6 +384,7 @@ done:
     free(bd.b.label);
     free(bd.ring);
     free(bd.labels);
+    free(bd.doubtful);
     if (rc)
         gp_cells_free(out);
     return rc;

@@ -31,8 +31,8 @@ typedef struct gp_laguerre_params {
     int flush_boundary; /* offset only: edges on the domain boundary stay where they are */
 } gp_laguerre_params;
 
-/* An edge of a power cell shorter than this fraction of the packing radius of its grain
- * does not make two grains neighbours. Why this value: cell vertices are computed to a
+/* An edge of a power cell shorter than this fraction of the mean packing radius of its
+ * two grains does not make them neighbours. Why this value: cell vertices are computed to a
  * few ulps of the radius (coordinates are taken relative to the centre), about 1e-15 R;
  * an edge of 1e-9 R is far above that noise, and far below any real contact (four
  * centres on one power circle give an edge of exactly zero, which rounding turns into
@@ -47,7 +47,8 @@ typedef struct gp_cells {
     double *xy;           /* vertices, x and y interleaved, counter-clockwise, convex */
     size_t *nstart;       /* count + 1 offsets into neighbours */
     int32_t *neighbours;  /* ids of the grains whose power cell shares an edge (longer than
-                             GP_LAGUERRE_EDGE_RTOL R) with this one, counter-clockwise */
+                             GP_LAGUERRE_EDGE_RTOL (R_i + R_j) / 2) with this one, in
+                             counter-clockwise order; the relation is symmetric */
     double *area;         /* area of each (shrunk) cell */
     double power_area_sum;/* sum of the areas of the unshrunk power cells: the domain's */
 } gp_cells;
