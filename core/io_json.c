@@ -89,6 +89,11 @@ static json_t *balance_json(const gp_balance_result *b, int *failed)
     }
     put(o, "method", json_string(gp_balance_method_name(b->method)), failed);
     put(o, "max_step", json_real(b->max_step), failed);
+    if (b->after_only) { /* rebuilt from the final disks: the run itself is not known */
+        json_decref(t);
+        put(o, "after", quality_json(&b->after, failed), failed);
+        return o;
+    }
     put(o, "sweeps", json_integer(b->sweeps), failed);
     put(o, "best_sweep", json_integer(b->best_sweep), failed);
     put(o, "stop", json_string(gp_balance_stop_name(b->stop)), failed);

@@ -56,7 +56,8 @@ static colouring choose_colouring(const gp_spec *spec, const gp_result *result)
 {
     colouring c = {"grain radius", "r", 0.0, 0.0, NULL};
     if (spec->picture_color == GP_PICTURE_COLOR_QUALITY && result->has_balance) {
-        c = (colouring){"balance criterion F", "F", 0.0, result->balance.before.max, result->balance.F};
+        const gp_balance_result *b = &result->balance;
+        c = (colouring){"balance criterion F", "F", 0.0, b->after_only ? b->after.max : b->before.max, b->F};
         return c;
     }
     gp_distribution_support(&spec->dist, &c.lo, &c.hi);
@@ -178,11 +179,14 @@ static void draw_legend(FILE *out, const gp_spec *spec, const gp_result *result,
             (unsigned long long)spec->seed);
     fputs("</text>\n", out);
     double line_y = text_y + 1.4 * font;
-    if (result->has_balance)
+    const gp_balance_result *b = &result->balance;
+    if (result->has_balance && b->after_only)
+        fprintf(out, "<text x=\"0\" y=\"%.*f\">%s balancing: F_max %.3f, mean F %.3f</text>\n", dec,
+                line_y += 1.4 * font, gp_balance_method_name(b->method), b->after.max, b->after.mean);
+    else if (result->has_balance)
         fprintf(out, "<text x=\"0\" y=\"%.*f\">%s balancing: F_max %.3f to %.3f, mean F %.3f to %.3f</text>\n",
-                dec, line_y += 1.4 * font, gp_balance_method_name(result->balance.method),
-                result->balance.before.max, result->balance.after.max, result->balance.before.mean,
-                result->balance.after.mean);
+                dec, line_y += 1.4 * font, gp_balance_method_name(b->method), b->before.max,
+                b->after.max, b->before.mean, b->after.mean);
     if (result->has_cells)
         fprintf(out, "<text x=\"0\" y=\"%.*f\">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
                 dec, line_y += 1.4 * font, gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);

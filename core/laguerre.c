@@ -246,6 +246,8 @@ static void shrink(builder *bd, const gp_disk *p)
     /* the erosion of a convex polygon by j is the intersection of its edges' half-planes
      * moved inward by j; the cuts use the edges of the unshrunk cell */
     double j = p->R - p->r;
+    if (!(j > 0.0))
+        return; /* no joint: cutting the cell by its own edges again only adds rounding */
     size_t m = a->n;
     int32_t *labels = bd->labels;
     memcpy(labels, a->label, m * sizeof *labels);

@@ -2,6 +2,7 @@
  * stage. */
 #include "grainpack/pipeline.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -79,6 +80,43 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
 fail:
     gp_rt_free(rt);
     gp_result_free(result);
+    return rc;
+}
+
+int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
+{
+    gp_packing *pk = &result->packing;
+    if (!spec->balance_enabled && !spec->laguerre_enabled)
+        return 0;
+    gp_rt *rt;
+    int rc = gp_rt_build(pk->disks, pk->count, &rt, err);
+    if (rc)
+        return rc;
+    if (spec->balance_enabled) {
+        gp_balance_result *b = &result->balance;
+        memset(b, 0, sizeof *b);
+        b->method = spec->balance.method;
+        b->max_step = spec->balance.max_step;
+        b->count = pk->count;
+        b->after_only = 1;
+        b->F = malloc((pk->count ? pk->count : 1) * sizeof *b->F);
+        rc = b->F ? gp_quality(&spec->domain, rt, pk->disks, pk->count, b->F, &b->after, err)
+                  : gp_error_set(err, GP_ENOMEM, NULL, "out of memory for F");
+        if (rc)
+            gp_balance_result_free(b);
+        result->has_balance = rc == 0;
+    }
+    if (rc == 0 && spec->laguerre_enabled) {
+        rc = gp_laguerre(&spec->domain, pk->disks, pk->count, rt, &spec->laguerre, NULL,
+                         &result->cells, err);
+        if (rc == 0 && (rc = gp_cell_stats_compute(&spec->domain, &spec->dist, pk->disks,
+                                                   &result->cells, &result->cell_stats))) {
+            gp_error_set(err, rc, NULL, "out of memory computing cell statistics");
+            gp_cells_free(&result->cells);
+        }
+        result->has_cells = rc == 0;
+    }
+    gp_rt_free(rt);
     return rc;
 }
 

@@ -229,8 +229,14 @@ extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t c
     if (r.dimension() < 2)
         return n;
     *hull = infinite ? 1 : 0;
-    if (infinite && n <= cap) // start just after the outside of the hull
-        std::rotate(out, out + after_infinite, out + n);
+    if (n > cap)
+        return n;
+    // a canonical start, whatever face CGAL's circulator starts from: just after the
+    // outside of the hull, or the smallest id (so that updates and rebuilds agree)
+    size_t first = after_infinite;
+    if (!infinite)
+        first = static_cast<size_t>(std::min_element(out, out + n) - out);
+    std::rotate(out, out + first, out + n);
     return n;
 }
 

@@ -127,6 +127,9 @@ int gp_render_load(gp_db *db, const char *id, gp_spec *spec, gp_result *result)
     free(text);
     if (rc == 0)
         rc = gp_pack_stats_compute(&spec->domain, &spec->dist, &result->packing, &result->stats);
+    /* F and the Laguerre cells, rebuilt from the stored (balanced) disks */
+    if (rc == 0)
+        rc = gp_result_rederive(spec, result, &err);
     if (rc) {
         gp_spec_free(spec);
         gp_result_free(result);

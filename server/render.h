@@ -1,6 +1,7 @@
 /* render.h - a finished job's result as the client asked for it: the format chosen by
  * ?f= or Accept among the engine's writers (gp_format), and the result rebuilt from the
- * store (spec + disks; the statistics are computed again, deterministically). Every
+ * store (spec + disks; the statistics, F and the Laguerre cells are computed again from
+ * them, deterministically). Every
  * format the engine's gp_write_result knows is served without a change here. */
 #ifndef GRAINPACKD_RENDER_H
 #define GRAINPACKD_RENDER_H

@@ -252,6 +252,34 @@ static void test_method_none_measures_without_moving(void)
     gp_spec_free(&spec);
 }
 
+static void test_flips_and_rebuilds_give_the_same_structure(void)
+{
+    /* rings are canonical (gp_rt_ring), so the triangulation kept up by flips and the
+     * one built again after every sweep lead the sweeps through the same moves */
+    gp_spec spec;
+    load_example("iron", &spec);
+    gp_packing a, b;
+    pack_seed(&spec, 2, &a);
+    pack_seed(&spec, 2, &b);
+    gp_rt *ra, *rb;
+    gp_error err;
+    CHECK(gp_rt_build(a.disks, a.count, &ra, &err) == 0 && gp_rt_build(b.disks, b.count, &rb, &err) == 0);
+    gp_balance_params flips = {GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_FLIPS};
+    gp_balance_params rebuild = {GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_REBUILD};
+    gp_balance_result fa, fb;
+    CHECK(gp_balance(&spec.domain, a.disks, a.count, ra, &flips, NULL, &fa, &err) == 0);
+    CHECK(gp_balance(&spec.domain, b.disks, b.count, rb, &rebuild, NULL, &fb, &err) == 0);
+    CHECK(fa.sweeps == fb.sweeps && fa.moves == fb.moves && fa.triangulation.flips > 0 && fb.triangulation.flips == 0);
+    CHECK(memcmp(a.disks, b.disks, a.count * sizeof *a.disks) == 0);
+    gp_balance_result_free(&fa);
+    gp_balance_result_free(&fb);
+    gp_rt_free(ra);
+    gp_rt_free(rb);
+    gp_packing_free(&a);
+    gp_packing_free(&b);
+    gp_spec_free(&spec);
+}
+
 static void record_progress(void *ctx, const char *stage, double fraction)
 {
     double *last = ctx;
@@ -296,6 +324,7 @@ int main(void)
     RUN(test_method_none_measures_without_moving);
     RUN(test_relocation_beats_the_report_on_the_fixed_case);
     RUN(test_progress_rises_to_one_and_cancel_stops);
+    RUN(test_flips_and_rebuilds_give_the_same_structure);
     RUN(test_both_methods_keep_every_promise_on_the_reference_cases);
     return check_status();
 }

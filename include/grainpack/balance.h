@@ -108,6 +108,8 @@ typedef struct gp_balance_result {
     uint64_t moves;         /* centre moves over all sweeps */
     uint64_t refused;       /* centres that had somewhere to go but no conflict-free step */
     gp_rt_update_stats triangulation; /* how the triangulation followed */
+    int after_only;         /* rebuilt from the final disks (gp_result_rederive): only
+                               `method`, `F` and `after` are known, not the run itself */
 } gp_balance_result;
 
 /* Balances disks[0..n-1] in `domain` in place: moves interior centres (radii never

@@ -42,6 +42,15 @@ typedef struct gp_result {
 int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
                     gp_result *result, gp_error *err);
 
+/* Rebuilds, from the final disks in result->packing (what a store keeps) and the spec,
+ * what the stages after packing derived from them: F and its statistics when the spec
+ * balances, the Laguerre cells and their statistics when it builds cells. The same disks
+ * give the same bytes as the run did. What only the run saw (F before balancing, the
+ * sweeps) is not rebuilt: result->balance.after_only is set and the writers leave it
+ * out. Returns 0 or the stage's error code with err filled (result then keeps only
+ * what it had). */
+int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err);
+
 void gp_result_free(gp_result *result);
 
 /* Seconds spent in `stage`, or 0 if it did not run. */

@@ -50,7 +50,9 @@ int gp_rt_dimension(const gp_rt *rt);
  * edges of the ball (its link) are (out[k], out[k+1 mod degree]), each with p on its left.
  * For a hull vertex the ring starts just after the convex hull's outside and ends just
  * before it: the triangles and link edges are those with k + 1 < degree, and
- * (p, out[0]) and (out[degree-1], p) are hull edges. */
+ * (p, out[0]) and (out[degree-1], p) are hull edges. An interior vertex's ring starts at
+ * its smallest id: the same triangulation always gives the same ring, however it was
+ * built or updated. */
 size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap, int *on_hull);
 
 /* How to bring the triangulation up to date after centres moved. */

@@ -2,15 +2,18 @@
 """test_service_e2e.py - the report's four reference cases through the real daemon:
 submit, wait, fetch every format (by ?f= and by Accept), check the CSV for overlaps,
 compare the result with the command line's for the same spec, and check that the
-statistics in the database equal the API's. Every response is checked against
-openapi.yaml. Usage: test_service_e2e.py GRAINPACKD GRAINPACK_CLI"""
+statistics in the database equal the API's; then a job that balances and builds
+Laguerre cells, whose cells and F the service rebuilds from the stored disks exactly as
+the command line wrote them. Every response is checked against openapi.yaml.
+Usage: test_service_e2e.py GRAINPACKD GRAINPACK_CLI"""
 
 import subprocess
 
 import gpd
 
 CASES = ["fixed", "variable", "iron", "bagi"]
-FORMATS = {"json": "application/json", "csv": "text/csv", "svg": "image/svg+xml"}
+FORMATS = {"json": "application/json", "csv": "text/csv", "svg": "image/svg+xml",
+           "vtk": "application/x-vtk"}
 
 
 def check_service_documents(c, api, client):
@@ -26,7 +29,8 @@ def check_service_documents(c, api, client):
     processes = client.get("/processes").json()["processes"]
     c.check([p["id"] for p in processes] == ["pack2d"], f"processes {processes}")
     desc = client.get("/processes/pack2d").json()
-    c.check(set(desc["inputs"]) == {"domain", "distribution", "joint", "front", "seed"},
+    c.check(set(desc["inputs"]) == {"domain", "distribution", "joint", "front", "seed", "balance",
+                                    "laguerre", "picture"},
             f"process inputs {list(desc['inputs'])}")
     served = client.get("/openapi.yaml")
     api.check(c, "GET", "/openapi.yaml", served)
@@ -134,6 +138,37 @@ def check_case(c, api, client, daemon, cli, name):
     c.check(blob == (st["count"], 32 * st["count"]), f"{name}: results row {blob}")
 
 
+def check_staged(c, api, client, cli):
+    """A balanced job with Laguerre cells (the report's Figure 47): the service keeps the
+    final disks and rebuilds F and the cells from them; they match the command line's."""
+    spec = gpd.load_example("figure47")
+    r = client.submit(spec)
+    if not c.check(r.status == 201, f"staged: submit: {r}"):
+        return
+    job = r.json()["jobID"]
+    if not c.check(client.wait_final(job)["status"] == "successful", "staged: not successful"):
+        return
+    cli_out = {}
+    for fmt in ("json", "vtk"):
+        cli_out[fmt] = subprocess.run([cli, "run", "-", "--format", fmt], input=gpd.json.dumps(spec).encode(),
+                                      capture_output=True, check=True).stdout
+    vtk = client.get(f"/jobs/{job}/results?f=vtk")
+    api.check(c, "GET", "/jobs/{jobId}/results", vtk)
+    c.check(vtk.status == 200 and vtk.body == cli_out["vtk"], "staged: service VTK differs from the command line's")
+    r = client.get(f"/jobs/{job}/results?f=json")
+    api.check(c, "GET", "/jobs/{jobId}/results", r)
+    ours, theirs = r.json(), gpd.json.loads(cli_out["json"])
+    c.check(ours["cells"] == theirs["cells"] and ours["disks"] == theirs["disks"],
+            "staged: cells or F differ from the command line's")
+    c.check(ours["statistics"]["cells"] == theirs["statistics"]["cells"], "staged: cell statistics differ")
+    c.check(ours["statistics"]["balance"]["after"] == theirs["statistics"]["balance"]["after"],
+            "staged: F after balancing differs")
+    st = client.get(f"/jobs/{job}/statistics")
+    api.check(c, "GET", "/jobs/{jobId}/statistics", st)
+    stages = [t["stage"] for t in st.json()["timings"]]
+    c.check(stages == ["pack", "triangulation", "balance", "laguerre", "stats"], f"staged: timings {stages}")
+
+
 def test(c, binary, cli):
     api = gpd.OpenAPI()
     daemon = gpd.Daemon(binary, "--workers", "2")
@@ -143,10 +178,11 @@ def test(c, binary, cli):
         check_service_documents(c, api, client)
         for name in CASES:
             check_case(c, api, client, daemon, cli, name)
+        check_staged(c, api, client, cli)
         client.close()
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly on SIGTERM")
         log = daemon.log()
-        c.check(log.count(" successful: ") == len(CASES), "log: one 'successful' line per job")
+        c.check(log.count(" successful: ") == len(CASES) + 1, "log: one 'successful' line per job")
         c.check("POST /processes/pack2d/execution 201" in log, "log: request lines")
     finally:
         daemon.cleanup()
