@@ -11,6 +11,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "machine.h"
+
 #include "grainpack/pack.h"
 #include "grainpack/spec.h"
 #include "grainpack/stats.h"
@@ -110,33 +112,6 @@ static const struct {
     {"iron", "987 / 0.80 / < 0.01 s"},
     {"bagi", "~39000 / 0.84 / 6 s"},
 };
-
-static void print_machine(void)
-{
-    char model[256] = "unknown CPU";
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (f) {
-        char line[512];
-        while (fgets(line, sizeof line, f)) {
-            if (strncmp(line, "model name", 10) == 0) {
-                char *colon = strchr(line, ':');
-                if (colon) {
-                    snprintf(model, sizeof model, "%s", colon + 2);
-                    model[strcspn(model, "\n")] = '\0';
-                }
-                break;
-            }
-        }
-        fclose(f);
-    }
-#ifdef __OPTIMIZE__
-    const char *build = "optimised";
-#else
-    const char *build = "unoptimised";
-#endif
-    printf("Machine: %s, %ld cores online; one thread; %s build.\n\n", model,
-           sysconf(_SC_NPROCESSORS_ONLN), build);
-}
 
 static void bench_cases(const char *dir, int runs, int seeds)
 {

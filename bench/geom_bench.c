@@ -16,6 +16,7 @@
 #include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
 #include "grainpack/spec.h"
+#include "machine.h"
 
 static double now(void)
 {
@@ -309,35 +310,6 @@ static void bench_scaling(const char *dir, double max_grains, int quick)
         gp_spec_free(&spec);
     }
     printf("\n");
-}
-
-static void print_machine(void)
-{
-    char model[256] = "unknown CPU";
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (f) {
-        char line[512];
-        while (fgets(line, sizeof line, f)) {
-            if (strncmp(line, "model name", 10) == 0) {
-                char *colon = strchr(line, ':');
-                if (colon) {
-                    snprintf(model, sizeof model, "%s", colon + 2);
-                    model[strcspn(model, "\n")] = '\0';
-                }
-                break;
-            }
-        }
-        fclose(f);
-    }
-    double load[1] = {0};
-    getloadavg(load, 1);
-#ifdef __OPTIMIZE__
-    const char *build = "optimised";
-#else
-    const char *build = "unoptimised";
-#endif
-    printf("Machine: %s, %ld cores online; one thread; %s build; load average %.2f at the start.\n\n",
-           model, sysconf(_SC_NPROCESSORS_ONLN), build, load[0]);
 }
 
 int main(int argc, char **argv)

@@ -4,6 +4,7 @@
 #ifndef GRAINPACK_TESTS_PACKING_CHECKS_H
 #define GRAINPACK_TESTS_PACKING_CHECKS_H
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "grainpack/disk.h"
@@ -108,6 +109,17 @@ static inline void load_example(const char *name, gp_spec *spec)
         fprintf(stderr, "cannot load %s: %s %s\n", path, err.pointer, err.message);
         exit(2);
     }
+}
+
+/* A hexagonal patch of `rows` x `cols` touching disks of packing radius 1 (grain radius
+ * 0.9) with lower-left centre (x0, y0); returns how many it wrote to d. */
+static inline size_t hex_patch(gp_disk *d, int rows, int cols, double x0, double y0)
+{
+    size_t n = 0;
+    for (int i = 0; i < rows; i++)
+        for (int j = 0; j < cols; j++)
+            d[n++] = (gp_disk){x0 + 2.0 * j + (i % 2), y0 + sqrt(3.0) * i, 0.9, 1.0};
+    return n;
 }
 
 /* Packs `spec` with `seed` (its own level band), aborting the test program if it cannot. */

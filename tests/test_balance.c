@@ -17,17 +17,6 @@
 /* F of touching disks is 0 up to the rounding of the distances: a few ulps of 2R. */
 #define F_ROUNDING 1e-12
 
-/* A hexagonal patch of touching disks of packing radius 1 (grain radius 0.9) with
- * lower-left centre (x0, y0). */
-static size_t hex_patch(gp_disk *d, int rows, int cols, double x0, double y0)
-{
-    size_t n = 0;
-    for (int i = 0; i < rows; i++)
-        for (int j = 0; j < cols; j++)
-            d[n++] = (gp_disk){x0 + 2.0 * j + (i % 2), y0 + sqrt(3.0) * i, 0.9, 1.0};
-    return n;
-}
-
 static void quality_of(const gp_domain *dom, const gp_disk *d, size_t n, double *F, gp_quality_stats *q)
 {
     gp_rt *rt;

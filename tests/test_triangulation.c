@@ -10,16 +10,6 @@
 #include "grainpack/triangulation.h"
 #include "packing_checks.h"
 
-/* A hexagonal patch of `rows` x `cols` touching disks of packing radius 1. */
-static size_t hex_patch(gp_disk *d, int rows, int cols, double x0, double y0)
-{
-    size_t n = 0;
-    for (int i = 0; i < rows; i++)
-        for (int j = 0; j < cols; j++)
-            d[n++] = (gp_disk){x0 + 2.0 * j + (i % 2), y0 + sqrt(3.0) * i, 0.9, 1.0};
-    return n;
-}
-
 /* The ring of id, aborting the test on a buffer too small (64 is plenty here). */
 static size_t ring(const gp_rt *rt, int32_t id, int32_t *out, int *hull)
 {
