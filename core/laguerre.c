@@ -11,7 +11,8 @@
 /* Cells between two progress reports and cancel checks: a few milliseconds of work. */
 #define CELLS_PER_REPORT 16384
 
-/* Edge labels of a polygon under construction: a neighbour id (>= 0) or a wall. */
+/* Edge labels of a polygon under construction: the neighbour's index in the ring (>= 0)
+ * or a wall. */
 #define WALL_BOTTOM (-1)
 #define WALL_RIGHT (-2)
 #define WALL_TOP (-3)
@@ -122,6 +123,11 @@ static void wall_half_plane(const gp_domain *dom, const gp_disk *p, int32_t wall
     }
 }
 
+/* A half-plane u.(nx, ny) <= c relative to the centre; len = |(nx, ny)|. */
+typedef struct half_plane {
+    double nx, ny, c, len;
+} half_plane;
+
 /* Everything one run works with. */
 typedef struct builder {
     const gp_domain *domain;
@@ -135,6 +141,8 @@ typedef struct builder {
     size_t ndoubtful, doubtful_cap;
     int32_t *ring;
     size_t ring_cap;
+    half_plane *hp;  /* the radical half-plane of each ring neighbour */
+    size_t hp_cap;
     gp_cells *out;
     size_t nxy, xy_cap, nnb, nb_cap; /* used and allocated entries of out->xy / neighbours */
 } builder;
@@ -179,8 +187,15 @@ static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
     if (!labels)
         return GP_ENOMEM;
     bd->labels = labels;
+    half_plane *hp = grow(bd->hp, &bd->hp_cap, *degree ? *degree : 1, sizeof *hp);
+    if (!hp)
+        return GP_ENOMEM;
+    bd->hp = hp;
     if (polygon_reserve(&bd->a, 2 * m + 1) || polygon_reserve(&bd->b, 2 * m + 1))
         return GP_ENOMEM;
+    /* all the neighbours first: their loads, far apart in memory, then overlap */
+    for (size_t k = 0; k < *degree; k++)
+        hp[k].c = radical(p, &bd->disks[bd->ring[k]], &hp[k].nx, &hp[k].ny, &hp[k].len);
     double W = bd->domain->width, H = bd->domain->height;
     bd->a.n = 0;
     polygon_push(&bd->a, -p->x, -p->y, WALL_BOTTOM);
@@ -189,9 +204,8 @@ static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
     polygon_push(&bd->a, -p->x, H - p->y, WALL_LEFT);
     *holds_centre = p->x > 0.0 && p->y > 0.0 && p->x < W && p->y < H;
     for (size_t k = 0; k < *degree && bd->a.n > 0; k++) {
-        double nx, ny, len, c = radical(p, &bd->disks[bd->ring[k]], &nx, &ny, &len);
-        *holds_centre &= c > 0.0;
-        cut(&bd->a, nx, ny, c, bd->ring[k], &bd->b);
+        *holds_centre &= hp[k].c > 0.0;
+        cut(&bd->a, hp[k].nx, hp[k].ny, hp[k].c, (int32_t)k, &bd->b);
         polygon swap = bd->a;
         bd->a = bd->b;
         bd->b = swap;
@@ -210,9 +224,9 @@ static int record_neighbours(builder *bd, int32_t i)
         return GP_ENOMEM;
     bd->out->neighbours = nb;
     for (size_t k = 0; k < a->n; k++) {
-        int32_t j = a->label[k];
-        if (j < 0)
+        if (a->label[k] < 0)
             continue;
+        int32_t j = bd->ring[a->label[k]];
         size_t l = k + 1 < a->n ? k + 1 : 0;
         double ex = a->u[2 * l] - a->u[2 * k], ey = a->u[2 * l + 1] - a->u[2 * k + 1];
         double len2 = ex * ex + ey * ey;
@@ -252,10 +266,12 @@ static void shrink(builder *bd, const gp_disk *p)
     int32_t *labels = bd->labels;
     memcpy(labels, a->label, m * sizeof *labels);
     for (size_t k = 0; k < m && a->n > 0; k++) {
-        double nx, ny, c, len;
+        double nx, ny, c;
         if (labels[k] >= 0) {
-            c = radical(p, &bd->disks[labels[k]], &nx, &ny, &len);
-            c -= j * len;
+            const half_plane *h = &bd->hp[labels[k]];
+            nx = h->nx;
+            ny = h->ny;
+            c = h->c - j * h->len;
         } else {
             wall_half_plane(bd->domain, p, labels[k], bd->params->flush_boundary ? 0.0 : j, &nx, &ny, &c);
         }
@@ -385,6 +401,7 @@ done:
     free(bd.b.u);
     free(bd.b.label);
     free(bd.ring);
+    free(bd.hp);
     free(bd.labels);
     free(bd.doubtful);
     if (rc)
