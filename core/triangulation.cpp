@@ -191,22 +191,23 @@ extern "C" int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error
     return 0;
 }
 
-extern "C" void gp_rt_free(gp_rt *rt)
+extern "C" void gp_rt_free(gp_rt *rt) noexcept
 {
     delete rt;
 }
 
-extern "C" size_t gp_rt_count(const gp_rt *rt)
+extern "C" size_t gp_rt_count(const gp_rt *rt) noexcept
 {
     return rt->vertex.size();
 }
 
-extern "C" int gp_rt_dimension(const gp_rt *rt)
+extern "C" int gp_rt_dimension(const gp_rt *rt) noexcept
 {
     return rt->rt.dimension();
 }
 
-extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap, int *hull)
+extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
+                             int *hull) noexcept
 {
     const Rt &r = rt->rt;
     Vertex_handle v = rt->vertex[id];
@@ -276,7 +277,7 @@ extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks
     }
 }
 
-extern "C" int gp_rt_is_regular(const gp_rt *rt)
+extern "C" int gp_rt_is_regular(const gp_rt *rt) noexcept
 {
     try {
         return rt->rt.is_valid() && rt->rt.number_of_hidden_vertices() == 0;

@@ -13,6 +13,11 @@
 
 #ifdef __cplusplus
 extern "C" {
+/* The entry points that cannot fail are noexcept on the C++ side: should CGAL ever throw
+ * in one (a failed internal check), the program stops there rather than unwind into C. */
+#define GP_RT_NOEXCEPT noexcept
+#else
+#define GP_RT_NOEXCEPT
 #endif
 
 /* Opaque: owns the CGAL triangulation and a table from disk id (the index in the disks
@@ -30,14 +35,14 @@ typedef struct gp_rt gp_rt;
 int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err);
 
 /* Frees the triangulation (no-op on NULL). */
-void gp_rt_free(gp_rt *rt);
+void gp_rt_free(gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The number of vertices (= disks). */
-size_t gp_rt_count(const gp_rt *rt);
+size_t gp_rt_count(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The dimension of the triangulation: -1 empty, 0 one vertex, 1 all centres collinear,
  * 2 otherwise. Only dimension 2 has interior vertices and balls. */
-int gp_rt_dimension(const gp_rt *rt);
+int gp_rt_dimension(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The neighbours of vertex `id` (its ring), counter-clockwise around it. Writes the
  * first `cap` of them to `out` and returns how many there are (call again with a larger
@@ -53,7 +58,8 @@ int gp_rt_dimension(const gp_rt *rt);
  * (p, out[0]) and (out[degree-1], p) are hull edges. An interior vertex's ring starts at
  * its smallest id: the same triangulation always gives the same ring, however it was
  * built or updated. */
-size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap, int *on_hull);
+size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
+                  int *on_hull) GP_RT_NOEXCEPT;
 
 /* How to bring the triangulation up to date after centres moved. */
 typedef enum gp_rt_update {
@@ -85,7 +91,7 @@ int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks, const int
 /* Whether the triangulation is a valid regular triangulation of its current points
  * (CGAL's own check: every triangle counter-clockwise, every edge locally regular, no
  * hidden vertex). Costly; for the tests. */
-int gp_rt_is_regular(const gp_rt *rt);
+int gp_rt_is_regular(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 #ifdef __cplusplus
 }
