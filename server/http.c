@@ -1,66 +1,52 @@
-/* http.c - libmicrohttpd callbacks: gathering the request, routing, CORS, the response,
- * and the per-request log line. */
+/* http.c - libmicrohttpd callbacks: connections per address, gathering the request,
+ * admission (router.c), the route call, CORS, the response, and the per-request log
+ * line. */
 #include "http.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <unistd.h>
 
 #include "log.h"
+#include "peers.h"
 #include "problem.h"
-#include "routes.h"
+#include "router.h"
 
-/* Connections kept open at most: enough for 100 benchmark clients and 50 long-polls each
- * way, far below the file descriptor limit. */
-#define CONNECTION_LIMIT 2048
-/* Seconds an idle connection is kept; longer than the longest long-poll. */
-#define IDLE_TIMEOUT_MARGIN 60
 /* A body without Content-Length that passes the cap is read on (and dropped) up to this
  * many times the cap, so that the client still gets its 413; beyond, it is cut off. */
 #define DISCARD_FACTOR 16
 /* How long a browser may cache a CORS preflight answer. */
 #define CORS_MAX_AGE "600"
+/* libmicrohttpd answers by itself (431, in HTML) a request whose headers do not fit in a
+ * connection's memory pool; the pool is made this many times --max-header-bytes, so that
+ * headers a little over the limit still reach us and get our 431 problem instead. */
+#define HEADER_POOL_FACTOR 4
+#define MIN_POOL_BYTES ((size_t)32 * 1024)
+/* libmicrohttpd's own per-address limit is set this far above --max-connections-per-ip:
+ * connections in between are answered 429 by us, those beyond are dropped at accept. */
+#define PER_IP_HARD_MARGIN 16
+/* The body of a request must arrive within this many times --connection-timeout in all:
+ * a client trickling a byte at a time is cut off even though it is never silent. */
+#define BODY_DEADLINE_FACTOR 2
+/* The listen queue: enough for a burst of a few hundred clients connecting at once. */
+#define LISTEN_BACKLOG 1024
 
-/* A route table entry: a path pattern whose "{}" segment is an id, and a function per
- * method (NULL: not allowed). HEAD is served by GET. */
-typedef struct route {
-    const char *pattern;
-    gp_route_fn get, post, del;
-} route;
-
-static const route routes[] = {
-    {"/", gp_route_landing, NULL, NULL},
-    {"/conformance", gp_route_conformance, NULL, NULL},
-    {"/processes", gp_route_processes, NULL, NULL},
-    {"/processes/{}", gp_route_process, NULL, NULL},
-    {"/processes/{}/execution", NULL, gp_route_execute, NULL},
-    {"/jobs", gp_route_jobs, NULL, NULL},
-    {"/jobs/{}", gp_route_job, NULL, gp_route_dismiss},
-    {"/jobs/{}/results", gp_route_results, NULL, NULL},
-    {"/jobs/{}/statistics", gp_route_statistics, NULL, NULL},
-    {"/health", gp_route_health, NULL, NULL},
-    {"/metrics", gp_route_metrics, NULL, NULL},
-    {"/openapi.yaml", gp_route_openapi, NULL, NULL},
-};
-#define NROUTES (sizeof routes / sizeof routes[0])
-
-/* The longest id segment accepted; job ids are 36 characters. */
-#define ID_MAX 64
-
-/* Per-connection state, from the first call of a request to its completion. */
+/* Per-request state, from the first call of a request to its completion. */
 typedef struct request_state {
-    const route *route;
-    char id[ID_MAX + 1];
+    const gp_route_entry *route;
+    char id[GP_ID_MAX + 1];
+    gp_identity who; /* the key's identity, once checked */
+    const gp_identity *who_ptr;
+    const char *owner;
     char *body;
     size_t len, cap;
     int too_large;   /* the body passed the cap: it is dropped, 413 answers */
     size_t discarded;
     int answered;    /* a response was queued */
     int suspended;   /* a long-poll is waiting */
-    char method[8], path[200]; /* for the log line */
+    char method[8], path[200]; /* for the log line, sanitized */
     unsigned status;
     size_t bytes;
     double t0;
@@ -76,54 +62,14 @@ const char *gp_request_header(const gp_request *req, const char *name)
     return MHD_lookup_connection_value(req->conn, MHD_HEADER_KIND, name);
 }
 
-/* Matches url against the table; the "{}" segment goes to id. NULL when nothing matches
- * (an id segment longer than ID_MAX, or with odd characters, matches nothing either). */
-static const route *match(const char *url, char id[ID_MAX + 1])
+const char *gp_request_submitter(const gp_request *req)
 {
-    size_t n = strlen(url);
-    if (n > 1 && url[n - 1] == '/')
-        n--; /* "/jobs/" is "/jobs" */
-    for (size_t r = 0; r < NROUTES; r++) {
-        const char *p = routes[r].pattern, *u = url, *end = url + n;
-        id[0] = '\0';
-        int ok = 1;
-        while (ok && *p) {
-            if (p[0] == '{' && p[1] == '}') {
-                size_t k = 0;
-                while (u < end && *u != '/') {
-                    char c = *u++;
-                    int fine = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') ||
-                               (c >= 'A' && c <= 'Z') || c == '-' || c == '_' || c == '.';
-                    if (!fine || k == ID_MAX)
-                        ok = 0;
-                    else
-                        id[k++] = c;
-                }
-                id[k] = '\0';
-                ok = ok && k > 0;
-                p += 2;
-            } else if (u < end && *u == *p) {
-                u++;
-                p++;
-            } else {
-                ok = 0;
-            }
-        }
-        if (ok && u == end)
-            return &routes[r];
-    }
-    return NULL;
-}
-
-static void allow_list(const route *rt, char *out, size_t size)
-{
-    snprintf(out, size, "%s%s%sOPTIONS", rt->get ? "GET, HEAD, " : "", rt->post ? "POST, " : "",
-             rt->del ? "DELETE, " : "");
+    return req->who ? req->who->user : "";
 }
 
 /* Adds the CORS headers when the request comes from an allowed origin. */
 static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Response *resp,
-                     const route *rt, int preflight)
+                     const gp_route_entry *rt, int preflight)
 {
     const char *origin = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Origin");
     if (!gp_config_origin_allowed(svc->cfg, origin))
@@ -133,12 +79,13 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     if (!any)
         MHD_add_response_header(resp, "Vary", "Origin");
     MHD_add_response_header(resp, "Access-Control-Expose-Headers",
-                            "Location, Retry-After, Content-Type");
+                            "Location, Retry-After, Content-Type, WWW-Authenticate");
     if (preflight && rt) {
         char allow[64];
-        allow_list(rt, allow, sizeof allow);
+        gp_router_allow(rt, allow, sizeof allow);
         MHD_add_response_header(resp, "Access-Control-Allow-Methods", allow);
-        MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type, Accept");
+        MHD_add_response_header(resp, "Access-Control-Allow-Headers",
+                                "Content-Type, Accept, Authorization");
         MHD_add_response_header(resp, "Access-Control-Max-Age", CORS_MAX_AGE);
     }
 }
@@ -161,11 +108,15 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
         MHD_add_response_header(resp, "Location", reply->location);
     if (reply->allow[0])
         MHD_add_response_header(resp, "Allow", reply->allow);
+    if (reply->www_authenticate[0])
+        MHD_add_response_header(resp, "WWW-Authenticate", reply->www_authenticate);
     if (reply->retry_after > 0) {
         char seconds[16];
         snprintf(seconds, sizeof seconds, "%d", reply->retry_after);
         MHD_add_response_header(resp, "Retry-After", seconds);
     }
+    if (reply->close)
+        MHD_add_response_header(resp, "Connection", "close");
     add_cors(svc, conn, resp, st->route, preflight);
     enum MHD_Result rc = MHD_queue_response(conn, reply->status, resp);
     MHD_destroy_response(resp);
@@ -175,67 +126,6 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
     gp_metrics_request(svc->metrics, reply->status);
     gp_reply_free(reply);
     return rc;
-}
-
-/* Whether a Content-Type is JSON: application/json, parameters (charset) allowed. */
-static int is_json_type(const char *type)
-{
-    if (!type)
-        return 0;
-    while (*type == ' ')
-        type++;
-    size_t n = strlen("application/json");
-    return strncasecmp(type, "application/json", n) == 0 &&
-           (type[n] == '\0' || type[n] == ';' || type[n] == ' ');
-}
-
-/* Checks done before the body is read: path, method, media type, declared length.
- * Returns 1 with reply filled when the request is answered already. */
-static int precheck(gp_service *svc, struct MHD_Connection *conn, const char *url,
-                    const char *method, request_state *st, gp_reply *reply)
-{
-    if (!st->route) {
-        gp_problem(reply, 404, GP_PROBLEM_NOT_FOUND, url,
-                   "no resource at %s; GET / lists the API's links and GET /openapi.yaml "
-                   "describes it", url);
-        return 1;
-    }
-    const route *rt = st->route;
-    int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    int is_post = strcmp(method, "POST") == 0, is_del = strcmp(method, "DELETE") == 0;
-    if (strcmp(method, "OPTIONS") == 0) {
-        reply->status = 204;
-        allow_list(rt, reply->allow, sizeof reply->allow);
-        return 1;
-    }
-    if (!((is_get && rt->get) || (is_post && rt->post) || (is_del && rt->del))) {
-        allow_list(rt, reply->allow, sizeof reply->allow);
-        gp_problem(reply, 405, GP_PROBLEM_METHOD_NOT_ALLOWED, url,
-                   "%s is not allowed on %s; allowed: %s", method, url, reply->allow);
-        return 1;
-    }
-    if (!is_post)
-        return 0;
-    if (strcmp(st->id, GP_PROCESS_ID) != 0) { /* before the body: it would not be used */
-        gp_problem_no_such_process(reply, url, st->id);
-        return 1;
-    }
-    const char *type = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Content-Type");
-    if (!is_json_type(type)) {
-        gp_problem(reply, 415, GP_PROBLEM_UNSUPPORTED_MEDIA_TYPE, url,
-                   "the body must be sent as application/json (got %s%s%s); with curl: "
-                   "-H 'Content-Type: application/json'",
-                   type ? "'" : "no Content-Type", type ? type : "", type ? "'" : "");
-        return 1;
-    }
-    const char *length = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Content-Length");
-    if (length && strtoull(length, NULL, 10) > svc->cfg->max_body) {
-        gp_problem(reply, 413, GP_PROBLEM_BODY_TOO_LARGE, url,
-                   "the body has %s bytes, more than the limit of %zu (--max-body)", length,
-                   svc->cfg->max_body);
-        return 1;
-    }
-    return 0;
 }
 
 /* Appends upload data under the cap. Returns 0, or 1 when the cap was passed. */
@@ -258,6 +148,47 @@ static int gather(gp_service *svc, request_state *st, const char *data, size_t s
     return 0;
 }
 
+/* Adds the size of one header or query argument to *cls (a size_t). */
+static enum MHD_Result add_size(void *cls, enum MHD_ValueKind kind, const char *key,
+                                const char *value)
+{
+    (void)kind;
+    *(size_t *)cls += strlen(key) + (value ? strlen(value) : 0) + 4; /* ": " or "=&", CRLF */
+    return MHD_YES;
+}
+
+/* The first call of a request: the checks before its body. Returns the MHD result. */
+static enum MHD_Result begin_request(gp_service *svc, struct MHD_Connection *conn,
+                                     const char *url, const char *method, request_state *st)
+{
+    gp_reply reply;
+    memset(&reply, 0, sizeof reply);
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    const gp_peer_conn *peer = info ? info->socket_context : NULL;
+    if (peer && peer->over_limit) {
+        gp_problem(&reply, 429, GP_PROBLEM_TOO_MANY_CONNECTIONS, url,
+                   "%u connections are open from your address, the limit is %d "
+                   "(--max-connections-per-ip); this one is closed: reuse a connection "
+                   "(keep-alive) or wait for others to finish",
+                   peer->open, svc->cfg->max_connections_per_ip);
+        reply.retry_after = GP_RETRY_AFTER_SECONDS;
+        reply.close = 1;
+        return respond(svc, conn, st, &reply, 0);
+    }
+    size_t uri_bytes = strlen(url), header_bytes = strlen(method) + 12; /* " HTTP/1.1\r\n" */
+    MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, add_size, &uri_bytes);
+    MHD_get_connection_values(conn, MHD_HEADER_KIND, add_size, &header_bytes);
+    st->route = gp_router_match(url, st->id);
+    gp_request req = {svc, conn, method, url, st->id, NULL, 0, 0, NULL, NULL};
+    int answered = gp_router_admit(&req, st->route, uri_bytes, header_bytes, &st->who, &reply);
+    st->who_ptr = req.who ? &st->who : NULL;
+    if (answered)
+        return respond(svc, conn, st, &reply, strcmp(method, "OPTIONS") == 0);
+    st->owner = req.owner ? st->who.user : NULL;
+    return MHD_YES; /* the body (if any) comes in the next calls */
+}
+
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
                                   const char *method, const char *version,
                                   const char *upload_data, size_t *upload_size, void **con_cls)
@@ -273,24 +204,27 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         *con_cls = st;
         st->t0 = gp_monotonic_seconds();
         snprintf(st->method, sizeof st->method, "%s", method);
-        snprintf(st->path, sizeof st->path, "%s", url);
-        st->route = match(url, st->id);
-        if (precheck(svc, conn, url, method, st, &reply))
-            return respond(svc, conn, st, &reply, strcmp(method, "OPTIONS") == 0);
-        return MHD_YES; /* the body (if any) comes in the next calls */
+        gp_text_sanitize(st->path, sizeof st->path, url);
+        return begin_request(svc, conn, url, method, st);
     }
     if (st->answered)
         return MHD_YES;
     if (*upload_size) {
         /* past the cap the rest is read and dropped, and 413 answered once it is all in:
-         * libmicrohttpd cannot answer in the middle of a chunked upload. A client that
-         * keeps sending far past the cap is cut off. */
+         * libmicrohttpd cannot answer in the middle of an upload. A client that keeps
+         * sending far past the cap, or too slowly, is cut off. */
         size_t size = *upload_size;
         *upload_size = 0;
         if (!st->too_large && gather(svc, st, upload_data, size))
             st->too_large = 1;
         if (st->too_large && (st->discarded += size) > DISCARD_FACTOR * svc->cfg->max_body)
             return MHD_NO;
+        if (gp_monotonic_seconds() - st->t0 >
+            (double)(BODY_DEADLINE_FACTOR * svc->cfg->connection_timeout)) {
+            gp_log("http: %s %s: the body did not arrive within %d s: connection closed",
+                   st->method, st->path, BODY_DEADLINE_FACTOR * svc->cfg->connection_timeout);
+            return MHD_NO;
+        }
         return MHD_YES;
     }
     if (st->too_large) {
@@ -299,17 +233,34 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
                    svc->cfg->max_body);
         return respond(svc, conn, st, &reply, 0);
     }
-    const route *rt = st->route;
+    const gp_route_entry *rt = st->route;
     int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
     gp_route_fn fn = is_get ? rt->get : strcmp(method, "POST") == 0 ? rt->post : rt->del;
-    gp_request req = {svc,     conn,    method, url, st->id, st->body ? st->body : "",
-                      st->len, st->suspended};
+    gp_request req = {svc,     conn,          method,      url,      st->id, st->body ? st->body : "",
+                      st->len, st->suspended, st->who_ptr, st->owner};
     st->suspended = 0;
     if (fn(&req, &reply) == GP_ROUTE_SUSPENDED) {
         st->suspended = 1;
         return MHD_YES;
     }
     return respond(svc, conn, st, &reply, 0);
+}
+
+/* The client's address as text ("?" when unknown). */
+static void client_address(struct MHD_Connection *conn, char *addr, size_t size)
+{
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+    snprintf(addr, size, "?");
+    if (info && info->client_addr) {
+        const struct sockaddr *sa = info->client_addr;
+        if (sa->sa_family == AF_INET)
+            inet_ntop(AF_INET, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, addr,
+                      (socklen_t)size);
+        else if (sa->sa_family == AF_INET6)
+            inet_ntop(AF_INET6, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, addr,
+                      (socklen_t)size);
+    }
 }
 
 static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
@@ -319,26 +270,88 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
     request_state *st = *con_cls;
     if (!st)
         return;
-    const union MHD_ConnectionInfo *info =
-        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-    char addr[INET6_ADDRSTRLEN] = "?";
-    if (info && info->client_addr) {
-        const struct sockaddr *sa = info->client_addr;
-        if (sa->sa_family == AF_INET)
-            inet_ntop(AF_INET, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, addr,
-                      sizeof addr);
-        else if (sa->sa_family == AF_INET6)
-            inet_ntop(AF_INET6, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, addr,
-                      sizeof addr);
-    }
-    if (st->answered)
-        gp_log("http %s %s %s %u %zu bytes %.1f ms%s", addr, st->method, st->path, st->status,
-               st->bytes,
-               1e3 * (gp_monotonic_seconds() - st->t0),
+    if (st->answered) {
+        char addr[INET6_ADDRSTRLEN];
+        client_address(conn, addr, sizeof addr);
+        gp_log("http %s %s %s %s %u %zu bytes %.1f ms%s", addr, st->who_ptr ? st->who.user : "-",
+               st->method, st->path, st->status, st->bytes, 1e3 * (gp_monotonic_seconds() - st->t0),
                toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (connection closed early)");
+    }
     free(st->body);
     free(st);
     *con_cls = NULL;
+}
+
+/* Counts connections per address (the limit is applied to the first request). */
+static void on_connection(void *cls, struct MHD_Connection *conn, void **socket_context,
+                          enum MHD_ConnectionNotificationCode code)
+{
+    gp_service *svc = cls;
+    if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+        const union MHD_ConnectionInfo *info =
+            MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+        *socket_context = gp_peers_opened(svc->peers, info ? info->client_addr : NULL,
+                                          (unsigned)svc->cfg->max_connections_per_ip);
+    } else if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+        gp_peers_closed(svc->peers, *socket_context);
+        *socket_context = NULL;
+    }
+}
+
+static int hex_digit(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0'
+           : c >= 'a' && c <= 'f' ? c - 'a' + 10
+           : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                  : -1;
+}
+
+/* Decodes %HH escapes in the path and query values, except %00: a NUL would cut the
+ * text short and make "/jobs/%00x" the path "/jobs/". Left as it is, it matches no route
+ * and no parameter value. */
+static size_t unescape(void *cls, struct MHD_Connection *conn, char *s)
+{
+    (void)cls;
+    (void)conn;
+    char *w = s;
+    for (const char *r = s; *r;) {
+        int hi = r[0] == '%' ? hex_digit(r[1]) : -1, lo = hi >= 0 ? hex_digit(r[2]) : -1;
+        if (lo >= 0 && (hi | lo) != 0) {
+            *w++ = (char)(hi * 16 + lo);
+            r += 3;
+        } else {
+            *w++ = *r++;
+        }
+    }
+    *w = '\0';
+    return (size_t)(w - s);
+}
+
+/* Starts a daemon with the options both modes share. */
+static struct MHD_Daemon *start(gp_service *svc, unsigned flags, uint16_t port,
+                                const struct sockaddr *addr, unsigned threads)
+{
+    const gp_config *cfg = svc->cfg;
+    size_t pool = HEADER_POOL_FACTOR * cfg->max_header_bytes;
+    if (pool < MIN_POOL_BYTES)
+        pool = MIN_POOL_BYTES;
+    struct MHD_OptionItem options[] = {
+        {MHD_OPTION_NOTIFY_COMPLETED, (intptr_t)on_completed, svc},
+        {MHD_OPTION_NOTIFY_CONNECTION, (intptr_t)on_connection, svc},
+        {MHD_OPTION_UNESCAPE_CALLBACK, (intptr_t)unescape, NULL},
+        {MHD_OPTION_CONNECTION_LIMIT, cfg->max_connections, NULL},
+        {MHD_OPTION_PER_IP_CONNECTION_LIMIT, cfg->max_connections_per_ip + PER_IP_HARD_MARGIN, NULL},
+        {MHD_OPTION_CONNECTION_TIMEOUT, cfg->connection_timeout, NULL},
+        {MHD_OPTION_CONNECTION_MEMORY_LIMIT, (intptr_t)pool, NULL},
+        {threads > 1 ? MHD_OPTION_THREAD_POOL_SIZE : MHD_OPTION_END, threads, NULL},
+        {MHD_OPTION_END, 0, NULL},
+    };
+    if (addr)
+        return MHD_start_daemon(flags, port, NULL, NULL, on_request, svc, MHD_OPTION_SOCK_ADDR,
+                                addr, MHD_OPTION_LISTEN_BACKLOG_SIZE, (unsigned)LISTEN_BACKLOG,
+                                MHD_OPTION_ARRAY, options, MHD_OPTION_END);
+    return MHD_start_daemon(flags, 0, NULL, NULL, on_request, svc, MHD_OPTION_ARRAY, options,
+                            MHD_OPTION_END);
 }
 
 int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port)
@@ -364,12 +377,7 @@ int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port)
         gp_log("http: --host must be an IPv4 or IPv6 address, got '%s'", cfg->host);
         return GP_EINVAL;
     }
-    struct MHD_Daemon *d = MHD_start_daemon(
-        flags, (uint16_t)cfg->port, NULL, NULL, on_request, svc, MHD_OPTION_SOCK_ADDR, addr,
-        MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg->http_threads, MHD_OPTION_NOTIFY_COMPLETED,
-        on_completed, svc, MHD_OPTION_CONNECTION_LIMIT, (unsigned)CONNECTION_LIMIT,
-        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)(cfg->max_wait + IDLE_TIMEOUT_MARGIN),
-        MHD_OPTION_LISTEN_BACKLOG_SIZE, (unsigned)1024, MHD_OPTION_END);
+    struct MHD_Daemon *d = start(svc, flags, (uint16_t)cfg->port, addr, (unsigned)cfg->http_threads);
     if (!d) {
         gp_log("http: cannot listen on %s port %d (in use, or not an address of this machine)",
                cfg->host, cfg->port);
@@ -379,6 +387,12 @@ int gp_http_start(gp_service *svc, struct MHD_Daemon **out, unsigned *port)
     *port = info ? info->port : (unsigned)cfg->port;
     *out = d;
     return 0;
+}
+
+int gp_http_start_embedded(gp_service *svc, struct MHD_Daemon **out)
+{
+    *out = start(svc, MHD_USE_NO_LISTEN_SOCKET | MHD_ALLOW_SUSPEND_RESUME, 0, NULL, 1);
+    return *out ? 0 : GP_EIO;
 }
 
 void gp_http_quiesce(struct MHD_Daemon *daemon)

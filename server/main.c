@@ -1,6 +1,6 @@
-/* main.c - grainpackd: reads its options, opens the store, starts the workers and the
- * HTTP server, and on SIGTERM/SIGINT stops accepting, queues running jobs again and
- * closes cleanly. */
+/* main.c - grainpackd: reads its options and keys, opens the store, starts the workers
+ * and the HTTP server; on SIGHUP reads the key file again; on SIGTERM/SIGINT stops
+ * accepting, queues running jobs again and closes cleanly. */
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -11,9 +11,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "config.h"
 #include "http.h"
 #include "log.h"
+#include "peers.h"
 #include "service.h"
 #include "workers.h"
 
@@ -74,12 +76,16 @@ int main(int argc, char **argv)
         return rc > 0 ? 0 : 2;
 
     /* every thread inherits this mask: the signals are taken by sigwait below only */
-    sigset_t stop_signals;
-    sigemptyset(&stop_signals);
-    sigaddset(&stop_signals, SIGTERM);
-    sigaddset(&stop_signals, SIGINT);
-    pthread_sigmask(SIG_BLOCK, &stop_signals, NULL);
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGTERM);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGHUP);
+    pthread_sigmask(SIG_BLOCK, &signals, NULL);
     signal(SIGPIPE, SIG_IGN); /* a client that hangs up must not kill the daemon */
+    /* a file size limit reached is a write error sqlite reports (the disk is full), not a
+     * reason to die */
+    signal(SIGXFSZ, SIG_IGN);
 
     gp_service svc;
     memset(&svc, 0, sizeof svc);
@@ -90,6 +96,16 @@ int main(int argc, char **argv)
     struct MHD_Daemon *http = NULL;
     int status = 1, requeued = 0, lock_fd = -1;
     char why[512];
+    if (cfg.key_file[0]) {
+        if (gp_keyring_load(cfg.key_file, &svc.keys, why, sizeof why)) {
+            gp_log("%s", why);
+            goto done;
+        }
+        gp_log("%zu API keys read from %s", gp_keyring_count(svc.keys), cfg.key_file);
+    } else {
+        gp_log("no key file: the service is open to anyone who reaches %s (--key-file to "
+               "require API keys)", cfg.host);
+    }
     if (make_db_dir(cfg.db_path) || (lock_fd = lock_database(cfg.db_path)) < 0)
         goto done;
     if (gp_store_open(cfg.db_path, &svc.store, &requeued, why, sizeof why)) {
@@ -105,8 +121,8 @@ int main(int argc, char **argv)
     }
     gp_store_release(svc.store, db);
     atomic_store(&svc.queued, counts[GP_JOB_ACCEPTED]);
-    if (!(svc.metrics = gp_metrics_new()) || gp_waiters_start(&svc.waiters) ||
-        gp_pool_start(&svc, &svc.pool)) {
+    if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
+        gp_waiters_start(&svc.waiters) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");
         goto done;
     }
@@ -120,11 +136,24 @@ int main(int argc, char **argv)
     if (cfg.ready_file[0] && write_ready_file(cfg.ready_file, port))
         goto done;
 
-    int sig = 0;
-    while (sigwait(&stop_signals, &sig) != 0)
-        ;
-    gp_log("received %s: stopping (no new jobs; running jobs are queued again)",
-           sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    for (;;) {
+        int sig = 0;
+        if (sigwait(&signals, &sig) != 0)
+            continue;
+        if (sig == SIGHUP) {
+            if (!svc.keys)
+                gp_log("received SIGHUP: no key file to read again (the service is open)");
+            else if (gp_keyring_reload(svc.keys, why, sizeof why) == 0)
+                gp_log("received SIGHUP: %zu API keys read again from %s",
+                       gp_keyring_count(svc.keys), cfg.key_file);
+            else
+                gp_log("received SIGHUP: %s; the previous keys stay in use", why);
+            continue;
+        }
+        gp_log("received %s: stopping (no new jobs; running jobs are queued again)",
+               sig == SIGTERM ? "SIGTERM" : "SIGINT");
+        break;
+    }
     status = 0;
 
 done:
@@ -138,6 +167,8 @@ done:
     gp_pool_free(svc.pool);
     gp_waiters_free(svc.waiters);
     gp_metrics_free(svc.metrics);
+    gp_peers_free(svc.peers);
+    gp_keyring_free(svc.keys);
     gp_store_close(svc.store);
     if (lock_fd >= 0)
         close(lock_fd);

@@ -16,8 +16,8 @@ static const double bucket_bounds[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025
                                        300};
 #define NBUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
 
-static const char *const outcome_names[] = {"successful", "failed", "dismissed", "discarded",
-                                            "requeued"};
+static const char *const outcome_names[] = {"successful", "failed",    "timed_out",
+                                            "dismissed",  "discarded", "requeued"};
 #define NOUTCOMES (sizeof outcome_names / sizeof outcome_names[0])
 
 /* Durations are summed in microseconds so that the sum stays an atomic integer. */

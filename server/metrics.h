@@ -17,8 +17,9 @@ void gp_metrics_free(gp_metrics *m);
 /* One HTTP request answered with `status`. */
 void gp_metrics_request(gp_metrics *m, unsigned status);
 
-/* How a worker's run of a job ended: "successful", "failed", "dismissed" (canceled by a
- * DELETE), "discarded" (finished after a DELETE: result dropped) or "requeued". */
+/* How a worker's run of a job ended: "successful", "failed", "timed_out" (stopped by
+ * --max-job-seconds), "dismissed" (canceled by a DELETE), "discarded" (finished after a
+ * DELETE: result dropped) or "requeued". */
 void gp_metrics_outcome(gp_metrics *m, const char *outcome);
 
 /* A pipeline stage took `seconds` (histogram per stage name; names are static strings

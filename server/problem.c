@@ -3,34 +3,95 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
+
+#include "store.h"
 
 static const char *status_title(unsigned status)
 {
     switch (status) {
     case 400: return "Bad Request";
+    case 401: return "Unauthorized";
+    case 403: return "Forbidden";
     case 404: return "Not Found";
     case 405: return "Method Not Allowed";
     case 406: return "Not Acceptable";
     case 413: return "Content Too Large";
+    case 414: return "URI Too Long";
     case 415: return "Unsupported Media Type";
     case 422: return "Unprocessable Content";
+    case 429: return "Too Many Requests";
+    case 431: return "Request Header Fields Too Large";
     case 503: return "Service Unavailable";
     default: return status >= 500 ? "Internal Server Error" : "Error";
     }
 }
 
-/* Builds the body; `pointer`/`expected` are added when not NULL. */
+/* Length of the valid UTF-8 sequence (RFC 3629: no overlongs, no surrogates, at most
+ * U+10FFFF) at s, or 0. */
+static size_t utf8_length(const unsigned char *s)
+{
+    unsigned c = s[0];
+    if (c < 0x80)
+        return 1;
+    size_t n = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+    if (!n)
+        return 0;
+    for (size_t i = 1; i < n; i++)
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+    if ((c == 0xe0 && s[1] < 0xa0) || (c == 0xed && s[1] > 0x9f) || (c == 0xf0 && s[1] < 0x90) ||
+        (c == 0xf4 && s[1] > 0x8f))
+        return 0;
+    return n;
+}
+
+void gp_text_sanitize(char *out, size_t size, const char *text)
+{
+    static const char replacement[] = "\xef\xbf\xbd"; /* U+FFFD */
+    size_t o = 0;
+    if (!size)
+        return;
+    for (const unsigned char *s = (const unsigned char *)text; *s;) {
+        size_t n = utf8_length(s);
+        const char *piece = (const char *)s;
+        size_t len = n;
+        if (n == 0 || (n == 1 && (*s < 0x20 || *s == 0x7f))) {
+            piece = replacement;
+            len = 3;
+            n = 1;
+        }
+        if (o + len >= size)
+            break;
+        memcpy(out + o, piece, len);
+        o += len;
+        s += n;
+    }
+    out[o] = '\0';
+}
+
+/* Adds member name = text made valid (see gp_text_sanitize) to p, when text is not NULL. */
+static void set_text(json_t *p, const char *name, const char *text)
+{
+    char clean[2400];
+    if (!p || !text)
+        return;
+    gp_text_sanitize(clean, sizeof clean, text);
+    json_object_set_new(p, name, json_string(clean));
+}
+
+/* Builds the body; `instance`, `pointer` and `expected` are added when not NULL. Every
+ * text is sanitized: a message cut inside a character, or a path of raw bytes, must not
+ * make the problem itself fail. */
 static void build(gp_reply *reply, unsigned status, const char *type, const char *instance,
                   const char *detail, const char *pointer, const char *expected)
 {
-    json_t *p = json_pack("{s:s, s:s, s:i, s:s}", "type", type, "title", status_title(status),
-                          "status", (int)status, "detail", detail);
-    if (p && instance)
-        json_object_set_new(p, "instance", json_string(instance));
-    if (p && pointer)
-        json_object_set_new(p, "pointer", json_string(pointer));
-    if (p && expected)
-        json_object_set_new(p, "expected", json_string(expected));
+    json_t *p = json_pack("{s:s, s:s, s:i}", "type", type, "title", status_title(status),
+                          "status", (int)status);
+    set_text(p, "detail", detail);
+    set_text(p, "instance", instance);
+    set_text(p, "pointer", pointer);
+    set_text(p, "expected", expected);
     if (gp_reply_json(reply, status, GP_PROBLEM_MEDIA_TYPE, p))
         reply->status = status; /* out of memory: at least the status is right */
 }
@@ -62,6 +123,22 @@ void gp_problem_store_unavailable(gp_reply *reply, const char *instance)
 {
     gp_problem(reply, 503, GP_PROBLEM_INTERNAL, instance,
                "the job store is not available right now; try again");
+    reply->retry_after = GP_RETRY_AFTER_SECONDS;
+}
+
+void gp_problem_store_error(gp_reply *reply, const char *instance, int rc, const char *action)
+{
+    if (rc == GP_SRV_EFULL)
+        gp_problem(reply, 503, GP_PROBLEM_STORAGE_FULL, instance,
+                   "the database's disk is full: %s. Nothing was lost; try again once an "
+                   "administrator has freed space", action);
+    else if (rc == GP_SRV_EREADONLY)
+        gp_problem(reply, 503, GP_PROBLEM_STORAGE_READ_ONLY, instance,
+                   "the database cannot be written (read-only file or file system): %s. "
+                   "Nothing was lost; try again once an administrator has fixed it", action);
+    else
+        gp_problem(reply, 503, GP_PROBLEM_INTERNAL, instance,
+                   "the job store is not available right now: %s; try again", action);
     reply->retry_after = GP_RETRY_AFTER_SECONDS;
 }
 

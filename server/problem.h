@@ -28,9 +28,20 @@
 #define GP_PROBLEM_QUEUE_FULL "urn:grainpack:problem:queue-full"
 #define GP_PROBLEM_SHUTTING_DOWN "urn:grainpack:problem:shutting-down"
 #define GP_PROBLEM_INTERNAL "urn:grainpack:problem:internal"
+#define GP_PROBLEM_UNAUTHORIZED "urn:grainpack:problem:unauthorized"
+#define GP_PROBLEM_FORBIDDEN "urn:grainpack:problem:forbidden"
+#define GP_PROBLEM_TOO_MANY_JOBS "urn:grainpack:problem:too-many-jobs"
+#define GP_PROBLEM_TOO_MANY_CONNECTIONS "urn:grainpack:problem:too-many-connections"
+#define GP_PROBLEM_HEADERS_TOO_LARGE "urn:grainpack:problem:headers-too-large"
+#define GP_PROBLEM_URI_TOO_LONG "urn:grainpack:problem:uri-too-long"
+#define GP_PROBLEM_STORAGE_FULL "urn:grainpack:problem:storage-full"
+#define GP_PROBLEM_STORAGE_READ_ONLY "urn:grainpack:problem:storage-read-only"
 
 /* Fills reply with a problem: status, type, the standard title of the status and a
- * printf-style detail. `instance` (the request path) may be NULL. */
+ * printf-style detail. `instance` (the request path) may be NULL. Text that came from
+ * the request (a path, a parameter) may be any bytes: detail and instance are made valid
+ * UTF-8 without control characters first (each offending byte becomes U+FFFD), so that
+ * the body is always JSON. */
 void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *instance,
                 const char *detail_fmt, ...)
 #if defined(__GNUC__)
@@ -43,6 +54,15 @@ void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *
 void gp_problem_no_such_job(gp_reply *reply, const char *instance, const char *id);
 void gp_problem_no_such_process(gp_reply *reply, const char *instance, const char *id);
 void gp_problem_store_unavailable(gp_reply *reply, const char *instance);
+
+/* The store refused a write (rc from store.h): 503 with Retry-After, saying whether the
+ * disk is full (GP_SRV_EFULL), the database cannot be written (GP_SRV_EREADONLY) or it
+ * failed otherwise; `action` says what did not happen ("the job was not stored"). */
+void gp_problem_store_error(gp_reply *reply, const char *instance, int rc, const char *action);
+
+/* Copies text into out (size bytes, NUL-terminated, cut at a character boundary) as
+ * valid UTF-8 without control characters: each offending byte becomes U+FFFD. */
+void gp_text_sanitize(char *out, size_t size, const char *text);
 
 /* Seconds a client is told to wait by a 503. */
 #define GP_RETRY_AFTER_SECONDS 5

@@ -111,13 +111,13 @@ int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *rep
     return -1;
 }
 
-int gp_render_load(gp_db *db, const char *id, gp_spec *spec, gp_result *result)
+int gp_render_load(gp_db *db, const char *id, const char *owner, gp_spec *spec, gp_result *result)
 {
     memset(spec, 0, sizeof *spec);
     memset(result, 0, sizeof *result);
     char *text;
     size_t len;
-    int rc = gp_store_load_result(db, id, &text, &len, &result->packing);
+    int rc = gp_store_load_result(db, id, owner, &text, &len, &result->packing);
     if (rc)
         return rc;
     /* accepted once, so parsed without today's caps */

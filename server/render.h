@@ -15,10 +15,11 @@
  * unknown f, 406 when Accept allows none). */
 int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *reply);
 
-/* Rebuilds the spec and result of a successful job. On success returns 0 and the caller
- * frees both (gp_spec_free, gp_result_free); else GP_SRV_ENOTFOUND, GP_SRV_EDB,
- * GP_ENOMEM or the engine's code, with spec and result zeroed. Timings are not loaded. */
-int gp_render_load(gp_db *db, const char *id, gp_spec *spec, gp_result *result);
+/* Rebuilds the spec and result of a successful job of `owner` (NULL: any owner; see
+ * store.h). On success returns 0 and the caller frees both (gp_spec_free,
+ * gp_result_free); else GP_SRV_ENOTFOUND, GP_SRV_EDB, GP_ENOMEM or the engine's code,
+ * with spec and result zeroed. Timings are not loaded. */
+int gp_render_load(gp_db *db, const char *id, const char *owner, gp_spec *spec, gp_result *result);
 
 /* Writes the result in `format` to a new malloc'd buffer (*body, *len). Returns 0 or a
  * negative code. */

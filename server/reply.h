@@ -13,7 +13,9 @@ typedef struct gp_reply {
     size_t len;
     char location[160];       /* Location header, "" for none */
     char allow[64];           /* Allow header (405), "" for none */
-    int retry_after;          /* Retry-After seconds (503), 0 for none */
+    int retry_after;          /* Retry-After seconds (429, 503), 0 for none */
+    char www_authenticate[96]; /* WWW-Authenticate header (401), "" for none */
+    int close;                /* close the connection after this answer */
 } gp_reply;
 
 /* Serialises `value` (reference stolen) as the body with the given status and media type.

@@ -50,7 +50,7 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
-    gp_spec_limits limits = {svc->cfg->max_disks, 0};
+    gp_spec_limits limits = {svc->cfg->max_disks, svc->cfg->max_bins};
     gp_spec spec;
     gp_error err;
     gp_error_clear(&err);
@@ -69,18 +69,34 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
+    /* the per-key limit only applies to keys: without them there is nobody to count */
+    size_t max_active = req->who ? svc->cfg->max_jobs_per_key : 0;
+    const char *owner = gp_request_submitter(req);
     gp_job job;
+    long active = 0;
     gp_db *db = gp_store_acquire(svc->store, 1);
-    int rc = db ? gp_store_insert_job(db, req->body, req->body_len, &spec, &job) : GP_SRV_EDB;
+    int rc = db ? gp_store_insert_job(db, owner, max_active, req->body, req->body_len, &spec, &job,
+                                      &active)
+                : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     double expected = spec.expected_disks;
     gp_spec_free(&spec);
-    if (rc) {
+    if (rc == GP_SRV_ELIMIT) {
         atomic_fetch_sub(&svc->queued, 1);
-        gp_problem_store_unavailable(reply, req->path);
+        gp_problem(reply, 429, GP_PROBLEM_TOO_MANY_JOBS, req->path,
+                   "the key of '%s' has %ld jobs accepted or running, the limit is %zu "
+                   "(--max-jobs-per-key); wait for some to finish, or dismiss some",
+                   owner, active, max_active);
+        reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
-    gp_log("job %s accepted: about %.0f disks expected", job.id, expected);
+    if (rc) {
+        atomic_fetch_sub(&svc->queued, 1);
+        gp_problem_store_error(reply, req->path, rc, "the job was not stored");
+        return GP_ROUTE_DONE;
+    }
+    gp_log("job %s accepted from %s: about %.0f disks expected", job.id, owner[0] ? owner : "-",
+           expected);
     gp_pool_notify(svc->pool);
     snprintf(reply->location, sizeof reply->location, "/jobs/%s", job.id);
     gp_reply_json(reply, 201, JSON_TYPE, gp_job_status_info(&job));
@@ -129,7 +145,8 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
     size_t n = 0;
     int more = 0;
     gp_db *db = gp_store_acquire(svc->store, 1);
-    int rc = db ? gp_store_list_jobs(db, mask, cursor, (size_t)limit, jobs, &n, &more) : GP_SRV_EDB;
+    int rc = db ? gp_store_list_jobs(db, req->owner, mask, cursor, (size_t)limit, jobs, &n, &more)
+                : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     if (rc) {
         free(jobs);
@@ -155,11 +172,12 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
     return GP_ROUTE_DONE;
 }
 
-/* Reads a job with a connection of its own. */
-static int read_job(gp_service *svc, const char *id, gp_job *job)
+/* Reads a job as the request may see it, with a connection of its own. */
+static int read_job(const gp_request *req, gp_job *job)
 {
+    gp_service *svc = req->svc;
     gp_db *db = gp_store_acquire(svc->store, 1);
-    int rc = db ? gp_store_get_job(db, id, job) : GP_SRV_EDB;
+    int rc = db ? gp_store_get_job(db, req->id, req->owner, job) : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     return rc;
 }
@@ -171,18 +189,18 @@ int gp_route_job(gp_request *req, gp_reply *reply)
     if (query_count(req, "wait", 0, svc->cfg->max_wait, &wait, reply))
         return GP_ROUTE_DONE;
     gp_job job;
-    int rc = read_job(svc, req->id, &job);
+    int rc = read_job(req, &job);
     /* the long-poll: register, look again (the job may have finished in between), and
      * suspend only if it still runs; a worker's wake-up or the deadline resumes us */
     if (rc == 0 && wait > 0 && !req->resumed && !gp_job_status_final(job.status)) {
         gp_waiter *w = gp_waiters_add(svc->waiters, req->conn, req->id,
                                       gp_monotonic_seconds() + (double)wait);
         if (w) {
-            rc = read_job(svc, req->id, &job);
+            rc = read_job(req, &job);
             if (rc == 0 && !gp_job_status_final(job.status)) {
                 if (gp_waiters_suspend(svc->waiters, w))
                     return GP_ROUTE_SUSPENDED;
-                rc = read_job(svc, req->id, &job);
+                rc = read_job(req, &job);
             } else {
                 gp_waiters_cancel(svc->waiters, w);
             }
@@ -205,14 +223,14 @@ int gp_route_dismiss(gp_request *req, gp_reply *reply)
     int deleted = 0;
     memset(&job, 0, sizeof job);
     gp_db *db = gp_store_acquire(svc->store, 1);
-    int rc = db ? gp_store_dismiss(db, req->id, &before, &deleted, &job) : GP_SRV_EDB;
+    int rc = db ? gp_store_dismiss(db, req->id, req->owner, &before, &deleted, &job) : GP_SRV_EDB;
     gp_store_release(svc->store, db);
     if (rc == GP_SRV_ENOTFOUND) {
         gp_problem_no_such_job(reply, req->path, req->id);
         return GP_ROUTE_DONE;
     }
     if (rc) {
-        gp_problem_store_unavailable(reply, req->path);
+        gp_problem_store_error(reply, req->path, rc, "the job was neither dismissed nor deleted");
         return GP_ROUTE_DONE;
     }
     if (deleted) {

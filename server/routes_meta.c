@@ -86,11 +86,18 @@ int gp_route_health(gp_request *req, gp_reply *reply)
     gp_db *db = gp_store_acquire(svc->store, 1);
     int db_ok = db && gp_store_healthy(db);
     gp_store_release(svc->store, db);
+    /* readable but the last write failed: the service answers, new jobs are refused */
+    int writes = gp_store_write_state(svc->store);
+    const char *database = !db_ok                       ? "unavailable"
+                           : writes == GP_SRV_EFULL     ? "full"
+                           : writes == GP_SRV_EREADONLY ? "read-only"
+                                                        : "ok";
+    const char *status = !db_ok ? "unavailable" : writes ? "degraded" : "ok";
     int accepting = atomic_load(&svc->accepting);
-    json_t *body = json_pack("{s:s, s:s, s:b, s:i, s:i, s:I, s:f, s:s}", "status",
-                             db_ok ? "ok" : "unavailable", "database", db_ok ? "ok" : "unavailable",
-                             "accepting", accepting, "workers", svc->cfg->workers, "workers_busy",
-                             gp_pool_busy(svc->pool), "queue_depth",
+    json_t *body = json_pack("{s:s, s:s, s:b, s:s, s:i, s:i, s:I, s:f, s:s}", "status", status,
+                             "database", database, "accepting", accepting, "access",
+                             svc->keys ? "keys" : "open", "workers", svc->cfg->workers,
+                             "workers_busy", gp_pool_busy(svc->pool), "queue_depth",
                              (json_int_t)atomic_load(&svc->queued), "uptime_seconds",
                              gp_monotonic_seconds() - svc->started, "version", GP_VERSION);
     gp_reply_json(reply, db_ok ? 200 : 503, JSON_TYPE, body);

@@ -15,7 +15,7 @@
 static int without_result(gp_request *req, gp_db *db, gp_reply *reply)
 {
     gp_job job;
-    int rc = gp_store_get_job(db, req->id, &job);
+    int rc = gp_store_get_job(db, req->id, req->owner, &job);
     if (rc == GP_SRV_ENOTFOUND) {
         gp_problem_no_such_job(reply, req->path, req->id);
     } else if (rc) {
@@ -45,7 +45,7 @@ static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp
     }
     if (without_result(req, db, reply))
         return 1;
-    int rc = gp_render_load(db, req->id, spec, result);
+    int rc = gp_render_load(db, req->id, req->owner, spec, result);
     if (rc == GP_SRV_ENOTFOUND) /* deleted between the two reads */
         return without_result(req, db, reply);
     if (rc) {

@@ -5,12 +5,14 @@
 
 #include <stdatomic.h>
 
+#include "auth.h"
 #include "config.h"
 #include "metrics.h"
 #include "store.h"
 #include "waiters.h"
 
 typedef struct gp_pool gp_pool;
+typedef struct gp_peers gp_peers;
 
 typedef struct gp_service {
     const gp_config *cfg;
@@ -18,6 +20,8 @@ typedef struct gp_service {
     gp_metrics *metrics;
     gp_waiters *waiters;
     gp_pool *pool;
+    gp_keyring *keys;     /* NULL: no key file, the service is open */
+    gp_peers *peers;      /* connections per client address */
     atomic_long queued;   /* accepted jobs not yet claimed: admission control and metrics */
     atomic_int accepting; /* 0 once shutdown began: submissions get 503 */
     double started;       /* monotonic seconds at start, for /health's uptime */

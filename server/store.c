@@ -2,8 +2,10 @@
  * makes. Each query is a statement prepared once per connection. */
 #include "store.h"
 
+#include <errno.h>
 #include <pthread.h>
 #include <sqlite3.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,6 +42,7 @@ enum stmt_id {
     ST_LOAD,
     ST_TIMINGS,
     ST_COUNT,
+    ST_ACTIVE,
     ST_COUNT_OF
 };
 
@@ -47,14 +50,16 @@ enum stmt_id {
 
 static const char *const stmt_sql[ST_COUNT_OF] = {
     [ST_INSERT] = "INSERT INTO jobs (id, status, created, updated, message, spec, domain_width,"
-                  " domain_height, distribution, joint, level_band, seed, expected_disks)"
-                  " VALUES (?1, 'accepted', ?2, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)"
+                  " domain_height, distribution, joint, level_band, seed, expected_disks, owner)"
+                  " VALUES (?1, 'accepted', ?2, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)"
                   " RETURNING seq",
-    [ST_GET] = "SELECT " JOB_COLUMNS " FROM jobs WHERE id = ?1",
+    /* an owner of NULL sees every job */
+    [ST_GET] = "SELECT " JOB_COLUMNS " FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
     /* status_mask bit i selects status i, in gp_job_status order */
     [ST_LIST] = "SELECT " JOB_COLUMNS " FROM jobs WHERE seq < ?1 AND (?2 = 0 OR"
                 " (?2 >> (CASE status WHEN 'accepted' THEN 0 WHEN 'running' THEN 1"
                 " WHEN 'successful' THEN 2 WHEN 'failed' THEN 3 ELSE 4 END)) & 1)"
+                " AND (?4 IS NULL OR owner = ?4)"
                 " ORDER BY seq DESC LIMIT ?3",
     [ST_CLAIM] = "UPDATE jobs SET status = 'running', started = ?1, updated = ?1, progress = 0,"
                  " message = 'running', claims = claims + 1"
@@ -78,32 +83,36 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                 " updated = ?4 WHERE id = ?1 AND status = 'running'",
     [ST_REQUEUE] = "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
                    " message = ?2, updated = ?3 WHERE id = ?1 AND status = 'running'",
-    [ST_STATUS] = "SELECT status FROM jobs WHERE id = ?1",
+    [ST_STATUS] = "SELECT status FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
     [ST_DISMISS] = "UPDATE jobs SET status = 'dismissed', message = ?2, finished = ?3, updated = ?3"
                    " WHERE id = ?1 AND status IN ('accepted', 'running')",
     [ST_DELETE] = "DELETE FROM jobs WHERE id = ?1",
     [ST_LOAD] = "SELECT j.spec, r.count, r.disks, j.initial_disks, j.front_attempts,"
                 " j.front_closures, j.front_frozen, j.front_capped, j.max_level"
                 " FROM jobs j JOIN results r ON r.job_id = j.id"
-                " WHERE j.id = ?1 AND j.status = 'successful'",
+                " WHERE j.id = ?1 AND j.status = 'successful' AND (?2 IS NULL OR j.owner = ?2)",
     [ST_TIMINGS] = "SELECT stage, seconds FROM stage_timings WHERE job_id = ?1 ORDER BY position",
     [ST_COUNT] = "SELECT status, count(*) FROM jobs GROUP BY status",
+    [ST_ACTIVE] = "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('accepted', 'running')",
 };
 
 struct gp_db {
+    gp_store *store;
     sqlite3 *conn;
     sqlite3_stmt *stmt[ST_COUNT_OF];
     sqlite3_stmt *begin, *commit, *rollback;
     int durable;
+    int broken; /* an I/O or permission error: closed when released, not reused */
     gp_db *next_free;
 };
 
 struct gp_store {
     char *path;
-    pthread_mutex_t lock; /* guards free_list and all_list only */
+    pthread_mutex_t lock; /* guards free_list and all only */
     gp_db *free_list[2];  /* idle connections, by durability */
-    gp_db **all;          /* every connection opened, closed by gp_store_close */
+    gp_db **all;          /* every connection open, closed by gp_store_close */
     size_t nall, capall;
+    atomic_int write_state; /* 0, GP_SRV_EFULL or GP_SRV_EREADONLY: the last write's fate */
 };
 
 static const char *const status_names[GP_JOB_NSTATUS] = {"accepted", "running", "successful",
@@ -125,10 +134,37 @@ int gp_job_status_parse(const char *name, gp_job_status *out)
     return GP_EINVAL;
 }
 
+/* What the last failure of db's connection means for the caller: no space (the disk,
+ * a quota or the file size limit), no permission to write (read-only file or file
+ * system; EPERM is what an immutable file gives), or anything else. */
+static int classify(gp_db *db)
+{
+    int primary = sqlite3_extended_errcode(db->conn) & 0xff;
+    int sys = sqlite3_system_errno(db->conn);
+    if (primary == SQLITE_FULL || (primary == SQLITE_IOERR && (sys == ENOSPC || sys == EDQUOT ||
+                                                                sys == EFBIG)))
+        return GP_SRV_EFULL;
+    if (primary == SQLITE_READONLY ||
+        (primary == SQLITE_IOERR && (sys == EROFS || sys == EPERM || sys == EACCES)))
+        return GP_SRV_EREADONLY;
+    return GP_SRV_EDB;
+}
+
+/* Logs a failure and returns its class (see classify). A connection that met an I/O or
+ * permission error is not trusted again: it is closed when released. */
 static int db_fail(gp_db *db, const char *what)
 {
-    gp_log("store: %s: %s", what, sqlite3_errmsg(db->conn));
-    return GP_SRV_EDB;
+    int primary = sqlite3_extended_errcode(db->conn) & 0xff;
+    int sys = sqlite3_system_errno(db->conn);
+    int rc = classify(db);
+    gp_log("store: %s: %s%s%s", what, sqlite3_errmsg(db->conn), sys ? ": " : "",
+           sys ? strerror(sys) : "");
+    if (primary == SQLITE_IOERR || primary == SQLITE_READONLY || primary == SQLITE_CORRUPT ||
+        primary == SQLITE_CANTOPEN)
+        db->broken = 1;
+    if (rc != GP_SRV_EDB && db->store)
+        atomic_store(&db->store->write_state, rc);
+    return rc;
 }
 
 static void db_close(gp_db *db)
@@ -211,11 +247,14 @@ static int begin(gp_db *db)
 
 static int commit(gp_db *db)
 {
-    if (step_simple(db->commit) == 0)
+    if (step_simple(db->commit) == 0) {
+        if (db->store)
+            atomic_store(&db->store->write_state, 0);
         return 0;
-    db_fail(db, "commit");
+    }
+    int rc = db_fail(db, "commit");
     step_simple(db->rollback);
-    return GP_SRV_EDB;
+    return rc;
 }
 
 static void rollback(gp_db *db)
@@ -315,6 +354,8 @@ int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, si
     }
     pthread_mutex_init(&store->lock, NULL);
     gp_db *db = db_open(path, 1, why, why_size);
+    if (db)
+        db->store = store;
     int rc = db ? migrate(db, why, why_size) : GP_SRV_EDB;
     if (rc == 0)
         rc = requeue_running(db, requeued, why, why_size);
@@ -359,6 +400,7 @@ gp_db *gp_store_acquire(gp_store *store, int durable)
         gp_log("store: %s", why);
         return NULL;
     }
+    db->store = store;
     pthread_mutex_lock(&store->lock);
     int rc = remember(store, db);
     pthread_mutex_unlock(&store->lock);
@@ -374,6 +416,18 @@ void gp_store_release(gp_store *store, gp_db *db)
     if (!db)
         return;
     rollback(db); /* a caller that bailed out mid-transaction must not hold the write lock */
+    if (db->broken) {
+        pthread_mutex_lock(&store->lock);
+        for (size_t i = 0; i < store->nall; i++) {
+            if (store->all[i] == db) {
+                store->all[i] = store->all[--store->nall];
+                break;
+            }
+        }
+        pthread_mutex_unlock(&store->lock);
+        db_close(db);
+        return;
+    }
     pthread_mutex_lock(&store->lock);
     db->next_free = store->free_list[db->durable];
     store->free_list[db->durable] = db;
@@ -423,18 +477,51 @@ static void read_job(sqlite3_stmt *s, gp_job *job)
     copy_text(job->message, sizeof job->message, s, 8);
 }
 
-int gp_store_insert_job(gp_db *db, const char *spec_text, size_t spec_len, const gp_spec *spec,
-                        gp_job *out)
+/* The owner's accepted and running jobs; inside the inserting transaction. */
+static int count_active(gp_db *db, const char *owner, long *active)
 {
+    sqlite3_stmt *s = stmt(db, ST_ACTIVE);
+    if (!s)
+        return GP_SRV_EDB;
+    sqlite3_bind_text(s, 1, owner, -1, SQLITE_STATIC);
+    int rc = sqlite3_step(s);
+    *active = rc == SQLITE_ROW ? (long)sqlite3_column_int64(s, 0) : 0;
+    sqlite3_reset(s);
+    return rc == SQLITE_ROW ? 0 : db_fail(db, "count active jobs");
+}
+
+int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
+                        size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
+{
+    long n_active = 0;
+    if (active)
+        *active = 0;
     memset(out, 0, sizeof *out);
     new_job_id(out->id);
     gp_timestamp_now(out->created);
     snprintf(out->updated, sizeof out->updated, "%s", out->created);
     snprintf(out->message, sizeof out->message, "queued");
     out->status = GP_JOB_ACCEPTED;
+    int rc = begin(db);
+    if (rc)
+        return rc;
+    /* the count and the insert in one transaction: two submissions of one key cannot
+     * both see room for one more */
+    if (max_active > 0) {
+        if ((rc = count_active(db, owner, &n_active)) == 0 && n_active >= (long)max_active)
+            rc = GP_SRV_ELIMIT;
+        if (active)
+            *active = n_active;
+        if (rc) {
+            rollback(db);
+            return rc;
+        }
+    }
     sqlite3_stmt *s = stmt(db, ST_INSERT);
-    if (!s)
+    if (!s) {
+        rollback(db);
         return GP_SRV_EDB;
+    }
     sqlite3_bind_text(s, 1, out->id, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 2, out->created, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 3, spec_text, (int)spec_len, SQLITE_STATIC);
@@ -445,25 +532,34 @@ int gp_store_insert_job(gp_db *db, const char *spec_text, size_t spec_len, const
     sqlite3_bind_int(s, 8, (int)spec->level_band);
     sqlite3_bind_int64(s, 9, (sqlite3_int64)spec->seed);
     sqlite3_bind_double(s, 10, spec->expected_disks);
-    if (begin(db))
-        return GP_SRV_EDB;
+    sqlite3_bind_text(s, 11, owner, -1, SQLITE_STATIC);
     if (sqlite3_step(s) != SQLITE_ROW) {
-        db_fail(db, "insert job");
+        rc = db_fail(db, "insert job");
         sqlite3_reset(s);
         rollback(db);
-        return GP_SRV_EDB;
+        return rc;
     }
     out->seq = sqlite3_column_int64(s, 0);
     sqlite3_reset(s);
     return commit(db);
 }
 
-int gp_store_get_job(gp_db *db, const char *id, gp_job *out)
+/* Binds owner to parameter i: NULL (every owner) or the name. */
+static void bind_owner(sqlite3_stmt *s, int i, const char *owner)
+{
+    if (owner)
+        sqlite3_bind_text(s, i, owner, -1, SQLITE_STATIC);
+    else
+        sqlite3_bind_null(s, i);
+}
+
+int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
 {
     sqlite3_stmt *s = stmt(db, ST_GET);
     if (!s)
         return GP_SRV_EDB;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
+    bind_owner(s, 2, owner);
     int rc = sqlite3_step(s);
     if (rc == SQLITE_ROW)
         read_job(s, out);
@@ -473,8 +569,8 @@ int gp_store_get_job(gp_db *db, const char *id, gp_job *out)
     return rc == SQLITE_DONE ? GP_SRV_ENOTFOUND : db_fail(db, "get job");
 }
 
-int gp_store_list_jobs(gp_db *db, unsigned status_mask, int64_t before, size_t limit,
-                       gp_job *out, size_t *n, int *more)
+int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
+                       size_t limit, gp_job *out, size_t *n, int *more)
 {
     *n = 0;
     *more = 0;
@@ -484,6 +580,7 @@ int gp_store_list_jobs(gp_db *db, unsigned status_mask, int64_t before, size_t l
     sqlite3_bind_int64(s, 1, before > 0 ? before : INT64_MAX);
     sqlite3_bind_int(s, 2, (int)status_mask);
     sqlite3_bind_int64(s, 3, (sqlite3_int64)limit + 1); /* one more tells whether there is more */
+    bind_owner(s, 4, owner);
     int rc;
     while ((rc = sqlite3_step(s)) == SQLITE_ROW) {
         if (*n == limit) {
@@ -503,8 +600,11 @@ int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t 
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
     sqlite3_stmt *s = stmt(db, ST_CLAIM);
-    if (!s || begin(db))
+    if (!s)
         return GP_SRV_EDB;
+    int began = begin(db);
+    if (began)
+        return began;
     sqlite3_bind_text(s, 1, now, -1, SQLITE_STATIC);
     int rc = sqlite3_step(s), result = 0;
     if (rc == SQLITE_ROW) {
@@ -549,12 +649,13 @@ int gp_store_progress(gp_db *db, const char *id, int percent, const char *messag
     sqlite3_bind_int(s, 2, percent);
     sqlite3_bind_text(s, 3, message, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 4, now, -1, SQLITE_STATIC);
-    if (begin(db))
-        return GP_SRV_EDB;
+    int rc = begin(db);
+    if (rc)
+        return rc;
     if (step_simple(s)) {
-        db_fail(db, "progress");
+        rc = db_fail(db, "progress");
         rollback(db);
-        return GP_SRV_EDB;
+        return rc;
     }
     return commit(db);
 }
@@ -619,8 +720,11 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     snprintf(message, sizeof message, "%zu disks, packing density %.4f", st->count,
              st->packing_density);
     sqlite3_stmt *s = stmt(db, ST_FINISH);
-    if (!s || begin(db))
+    if (!s)
         return GP_SRV_EDB;
+    int began = begin(db);
+    if (began)
+        return began;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 2, message, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 3, now, -1, SQLITE_STATIC);
@@ -660,8 +764,11 @@ static int update_running(gp_db *db, enum stmt_id which, const char *id, const c
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
     sqlite3_stmt *s = stmt(db, which);
-    if (!s || begin(db))
+    if (!s)
         return GP_SRV_EDB;
+    int began = begin(db);
+    if (began)
+        return began;
     int n = 1;
     sqlite3_bind_text(s, n++, id, -1, SQLITE_STATIC);
     if (a)
@@ -690,14 +797,18 @@ int gp_store_requeue(gp_db *db, const char *id)
                           NULL, "requeue job");
 }
 
-int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *deleted,
-                     gp_job *after)
+int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
+                     int *deleted, gp_job *after)
 {
     *deleted = 0;
     sqlite3_stmt *s = stmt(db, ST_STATUS);
-    if (!s || begin(db))
+    if (!s)
         return GP_SRV_EDB;
+    int began = begin(db);
+    if (began)
+        return began;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
+    bind_owner(s, 2, owner);
     int rc = sqlite3_step(s), result = 0;
     gp_job_status st = GP_JOB_FAILED;
     if (rc == SQLITE_ROW)
@@ -708,7 +819,7 @@ int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *dele
     else if (rc != SQLITE_ROW)
         result = db_fail(db, "dismiss: read status");
     if (result == 0)
-        gp_store_get_job(db, id, after);
+        gp_store_get_job(db, id, NULL, after);
     if (result == 0 && !gp_job_status_final(st)) {
         char now[GP_TIMESTAMP_SIZE];
         gp_timestamp_now(now);
@@ -722,7 +833,7 @@ int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *dele
                 result = db_fail(db, "dismiss");
         }
         if (result == 0)
-            gp_store_get_job(db, id, after);
+            gp_store_get_job(db, id, NULL, after);
     } else if (result == 0) {
         if (!(s = stmt(db, ST_DELETE))) {
             result = GP_SRV_EDB;
@@ -741,8 +852,8 @@ int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *dele
     return commit(db);
 }
 
-int gp_store_load_result(gp_db *db, const char *id, char **spec_text, size_t *spec_len,
-                         gp_packing *packing)
+int gp_store_load_result(gp_db *db, const char *id, const char *owner, char **spec_text,
+                         size_t *spec_len, gp_packing *packing)
 {
     *spec_text = NULL;
     memset(packing, 0, sizeof *packing);
@@ -750,6 +861,7 @@ int gp_store_load_result(gp_db *db, const char *id, char **spec_text, size_t *sp
     if (!s)
         return GP_SRV_EDB;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
+    bind_owner(s, 2, owner);
     int rc = sqlite3_step(s);
     if (rc != SQLITE_ROW) {
         sqlite3_reset(s);
@@ -823,6 +935,16 @@ int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS])
     }
     sqlite3_reset(s);
     return rc == SQLITE_DONE ? 0 : db_fail(db, "count jobs");
+}
+
+int gp_store_write_state(gp_store *store)
+{
+    return atomic_load(&store->write_state);
+}
+
+int gp_store_broken(const gp_db *db)
+{
+    return db && db->broken;
 }
 
 int gp_store_healthy(gp_db *db)

@@ -17,11 +17,15 @@
 enum {
     GP_SRV_ENOTFOUND = -100, /* no such job (or no job to claim) */
     GP_SRV_ESTATE = -101,    /* the job is not in the state the operation needs */
-    GP_SRV_EDB = -102        /* sqlite failed; the log has its message */
+    GP_SRV_EDB = -102,       /* sqlite failed; the log has its message */
+    GP_SRV_EFULL = -103,     /* the disk (or the file size limit) is full: nothing was written */
+    GP_SRV_EREADONLY = -104, /* the database cannot be written (read-only file or file
+                                system, permission): nothing was written */
+    GP_SRV_ELIMIT = -105     /* the owner has as many active jobs as allowed */
 };
 
 /* The schema version this build migrates to (PRAGMA user_version). */
-#define GP_STORE_SCHEMA_VERSION 1
+#define GP_STORE_SCHEMA_VERSION 2
 
 typedef enum gp_job_status {
     GP_JOB_ACCEPTED = 0,
@@ -71,20 +75,32 @@ void gp_store_close(gp_store *store);
 gp_db *gp_store_acquire(gp_store *store, int durable);
 void gp_store_release(gp_store *store, gp_db *db);
 
-/* Inserts an accepted job with a new id; the spec text is kept as submitted and its
- * summary (domain, law, seed...) in columns. Returns 0 with *out filled, or GP_SRV_EDB. */
-int gp_store_insert_job(gp_db *db, const char *spec_text, size_t spec_len, const gp_spec *spec,
-                        gp_job *out);
+/* Write failures: every function that writes returns GP_SRV_EFULL or GP_SRV_EREADONLY
+ * when sqlite could not write for lack of space or of permission (the transaction is
+ * rolled back: nothing half-written stays), GP_SRV_EDB for any other failure.
+ *
+ * Owners: functions taking `owner` see only that owner's jobs ("" is the owner of jobs
+ * submitted without a key); NULL sees every job (an admin, or a daemon without keys).
+ * A job of another owner is GP_SRV_ENOTFOUND, as if it did not exist. */
+
+/* Inserts an accepted job of `owner` (never NULL) with a new id; the spec text is kept
+ * as submitted and its summary (domain, law, seed...) in columns. When max_active > 0
+ * and the owner already has that many accepted or running jobs, nothing is inserted and
+ * GP_SRV_ELIMIT is returned (the count is in *active, which may be NULL); the count and
+ * the insert are one transaction, so concurrent submissions cannot overshoot. Returns 0
+ * with *out filled, GP_SRV_ELIMIT, or a write failure. */
+int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
+                        size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
 
 /* Reads a job's status. Returns 0, GP_SRV_ENOTFOUND or GP_SRV_EDB. */
-int gp_store_get_job(gp_db *db, const char *id, gp_job *out);
+int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out);
 
 /* Lists jobs newest first: those with seq < before (0: from the newest), of the statuses
  * whose bit (1 << status) is set in status_mask (0: all), at most `limit`. Writes the jobs
  * into out (room for limit) and their number into *n; *more is 1 when further jobs
  * match. Returns 0 or GP_SRV_EDB. */
-int gp_store_list_jobs(gp_db *db, unsigned status_mask, int64_t before, size_t limit,
-                       gp_job *out, size_t *n, int *more);
+int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
+                       size_t limit, gp_job *out, size_t *n, int *more);
 
 /* Claims the oldest accepted job atomically (UPDATE ... RETURNING): it becomes running.
  * Returns 0 with the id and a malloc'd copy of its spec text (caller frees), or
@@ -108,15 +124,16 @@ int gp_store_requeue(gp_db *db, const char *id);
 
 /* DELETE /jobs/{id}: an accepted or running job becomes dismissed (*deleted = 0); a
  * finished one (successful, failed, dismissed) is deleted with its results (*deleted =
- * 1). *before gets the status the job had. Returns 0, GP_SRV_ENOTFOUND or GP_SRV_EDB. */
-int gp_store_dismiss(gp_db *db, const char *id, gp_job_status *before, int *deleted,
-                     gp_job *after);
+ * 1). *before gets the status the job had. Returns 0, GP_SRV_ENOTFOUND or a write
+ * failure. */
+int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
+                     int *deleted, gp_job *after);
 
 /* What is needed to render a successful job's result again: the spec text (malloc'd,
  * caller frees) and the packing with its front diagnostics (free with gp_packing_free).
  * Returns 0, GP_SRV_ENOTFOUND (no such job or no result) or GP_SRV_EDB/GP_ENOMEM. */
-int gp_store_load_result(gp_db *db, const char *id, char **spec_text, size_t *spec_len,
-                         gp_packing *packing);
+int gp_store_load_result(gp_db *db, const char *id, const char *owner, char **spec_text,
+                         size_t *spec_len, gp_packing *packing);
 
 /* The stage timings of a job, in the order the stages ran (at most cap; stage names are
  * copied into names[i], 32 bytes each). Returns the count or a negative code. */
@@ -127,5 +144,14 @@ int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS]);
 
 /* Whether the database answers a query (for /health; cheap enough to poll). */
 int gp_store_healthy(gp_db *db);
+
+/* How the last write went: 0 (it succeeded, or none failed yet), GP_SRV_EFULL or
+ * GP_SRV_EREADONLY. Any successful write sets it back to 0. */
+int gp_store_write_state(gp_store *store);
+
+/* Whether the connection hit an I/O or permission error: a worker holding a connection
+ * for long gives it back (gp_store_release closes it) and takes a fresh one, which sees
+ * the file as it is now (writable again, say). */
+int gp_store_broken(const gp_db *db);
 
 #endif

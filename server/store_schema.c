@@ -46,5 +46,13 @@ static const char migration_1[] =
     "  seconds REAL NOT NULL,"
     "  PRIMARY KEY (job_id, position)) WITHOUT ROWID;";
 
-const char *const gp_store_migrations[] = {migration_1};
+/* Version 2: every job belongs to the API key (its user name) that submitted it. Jobs of
+ * version 1, and every job of a daemon running without a key file, have the owner ''
+ * (only an admin key sees them once keys are in use). The index serves the per-key
+ * limit (accepted and running jobs of one owner) and the owner's job list. */
+static const char migration_2[] =
+    "ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';"
+    "CREATE INDEX jobs_by_owner ON jobs (owner, status, seq);";
+
+const char *const gp_store_migrations[] = {migration_1, migration_2};
 const size_t gp_store_migration_count = sizeof gp_store_migrations / sizeof gp_store_migrations[0];
