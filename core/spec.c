@@ -537,7 +537,9 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
     if (limits && limits->max_bins)
         v.max_bins = limits->max_bins;
     json_error_t jerr;
-    json_t *root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
+    /* any JSON value is well-formed: `null` or `5` is valid JSON that is not a spec, so
+     * it is refused as invalid (with what it is), not as malformed */
+    json_t *root = json_loadb(text, len, JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, &jerr);
     if (!root)
         return gp_error_set(err, GP_EPARSE, "", "line %d, column %d: %s", jerr.line, jerr.column,
                             jerr.text);

@@ -12,6 +12,9 @@ void gp_log(const char *fmt, ...)
 #endif
     ;
 
+/* Drops every line from now on (on = 1) or writes them again (0): for the HTTP fuzzer. */
+void gp_log_silence(int on);
+
 /* Writes the current UTC time as RFC 3339 with milliseconds ("2026-11-21T05:34:00.123Z")
  * into out (at least GP_TIMESTAMP_SIZE bytes). */
 #define GP_TIMESTAMP_SIZE 32

@@ -69,6 +69,8 @@ typedef struct error_case {
 
 static const error_case errors[] = {
     {"{\"inputs\": {", GP_EPARSE, "", "line 1"},
+    {"null", GP_EINVAL, "", "got null"},
+    {" 42 ", GP_EINVAL, "", "got an integer"},
     {"[1,2]", GP_EINVAL, "", "must be an object"},
     {"{\"inputs\":[]}", GP_EINVAL, "/inputs", "must be an object, got an array"},
     {"{\"inputs\":{" DOM "," CONST "},\"extra\":1}", GP_EINVAL, "/extra", "unknown field"},

@@ -4,6 +4,7 @@ that a response matches its schema in openapi.yaml, and a few assertions.
 
 Only Debian's python3 with python3-yaml and python3-jsonschema (see .ci/setup)."""
 
+import hashlib
 import http.client
 import json
 import os
@@ -69,15 +70,19 @@ class Response:
 
 
 class Client:
-    """One keep-alive HTTP/1.1 connection to the daemon (one per thread)."""
+    """One keep-alive HTTP/1.1 connection to the daemon (one per thread); with `key`,
+    every request carries it as a Bearer key."""
 
-    def __init__(self, port, timeout=120):
+    def __init__(self, port, timeout=120, key=None):
         self.port = port
         self.timeout = timeout
         self.conn = None
+        self.key = key
 
     def request(self, method, path, body=None, headers=None, chunked=False):
         headers = dict(headers or {})
+        if self.key and "Authorization" not in headers:
+            headers["Authorization"] = f"Bearer {self.key}"
         for attempt in range(2):
             reused = self.conn is not None
             if self.conn is None:
@@ -190,8 +195,8 @@ class Daemon:
         self.port = int(open(ready).read())
         return self
 
-    def client(self):
-        return Client(self.port)
+    def client(self, key=None):
+        return Client(self.port, key=key)
 
     def log(self):
         try:
@@ -286,6 +291,58 @@ class OpenAPI:
 
 
 RFC3339 = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?Z$")
+
+
+def write_keys(path, users):
+    """Writes a key file for users {name: role} with fresh random keys, as the README
+    says; returns {name: key}."""
+    keys = {}
+    with open(path, "w") as f:
+        for name, role in users.items():
+            keys[name] = os.urandom(24).hex()
+            f.write(f"sha256:{hashlib.sha256(keys[name].encode()).hexdigest()} {name} {role}\n")
+    return keys
+
+
+def raw_exchange(port, data, timeout=30):
+    """Sends raw bytes on a new connection, half-closes it and returns all the daemon
+    sends back (b"" when it closes without answering)."""
+    import socket
+    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    out = b""
+    try:
+        try:
+            s.sendall(data)
+            s.shutdown(socket.SHUT_WR)
+        except OSError:
+            pass  # the daemon may close before all is sent (too large): read what it said
+        while True:
+            try:
+                piece = s.recv(65536)
+            except ConnectionResetError:
+                break
+            if not piece:
+                break
+            out += piece
+    finally:
+        s.close()
+    return out
+
+
+def parse_raw(data):
+    """(status, headers with lower-case names, body) of the first response in data, or
+    (None, {}, b"") when there is none."""
+    if not data.startswith(b"HTTP/1."):
+        return None, {}, b""
+    head, _, rest = data.partition(b"\r\n\r\n")
+    lines = head.decode("latin-1").split("\r\n")
+    status = int(lines[0].split()[1])
+    headers = {}
+    for line in lines[1:]:
+        name, _, value = line.partition(":")
+        headers[name.strip().lower()] = value.strip()
+    length = int(headers.get("content-length", len(rest)))
+    return status, headers, rest[:length]
 
 
 def load_example(name):

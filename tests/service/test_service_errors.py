@@ -37,7 +37,7 @@ SPEC_CASES = [
     ("an empty body", b"", 400, "urn:grainpack:problem:malformed-json", None, "JSON"),
     ("duplicate keys", b'{"inputs": {"seed": 1, "seed": 2}}', 400, "urn:grainpack:problem:malformed-json", None, "duplicate"),
     ("a JSON array", b"[1, 2]", 422, "urn:grainpack:problem:invalid-spec", "", "object"),
-    ("JSON null", b"null", 400, "urn:grainpack:problem:malformed-json", None, "expected"),
+    ("JSON null", b"null", 422, "urn:grainpack:problem:invalid-spec", "", "got null"),
     ("inputs not an object", {"inputs": 5}, 422, "urn:grainpack:problem:invalid-spec", "/inputs", "object"),
     ("an unknown top-level member", {"inputs": gpd.small_spec()["inputs"], "extra": 1}, 422,
      "urn:grainpack:problem:invalid-spec", "/extra", "unknown"),
