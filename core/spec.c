@@ -536,6 +536,11 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
         v.max_disks = limits->max_disks;
     if (limits && limits->max_bins)
         v.max_bins = limits->max_bins;
+    /* jansson reads a NUL byte between tokens as if it were white space; JSON has none */
+    const char *nul = memchr(text, '\0', len);
+    if (nul)
+        return gp_error_set(err, GP_EPARSE, "", "a NUL byte at offset %zu: JSON text has none",
+                            (size_t)(nul - text));
     json_error_t jerr;
     /* any JSON value is well-formed: `null` or `5` is valid JSON that is not a spec, so
      * it is refused as invalid (with what it is), not as malformed */

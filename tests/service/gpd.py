@@ -304,26 +304,33 @@ def write_keys(path, users):
     return keys
 
 
-def raw_exchange(port, data, timeout=30):
-    """Sends raw bytes on a new connection, half-closes it and returns all the daemon
-    sends back (b"" when it closes without answering)."""
+def raw_exchange(port, data, timeout=30, half_close=True):
+    """Sends raw bytes on a new connection (then, with half_close, says it has no more to
+    send) and returns what the daemon answers: everything up to the end of its first
+    response, or up to its closing the connection, or b"" when it closes without one.
+    (libmicrohttpd does not always close a half-closed connection after answering, so the
+    end of a response is found by its Content-Length, not by the close.)"""
     import socket
     s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
     out = b""
     try:
         try:
             s.sendall(data)
-            s.shutdown(socket.SHUT_WR)
+            if half_close:
+                s.shutdown(socket.SHUT_WR)
         except OSError:
             pass  # the daemon may close before all is sent (too large): read what it said
         while True:
             try:
                 piece = s.recv(65536)
-            except ConnectionResetError:
+            except (ConnectionResetError, socket.timeout):
                 break
             if not piece:
                 break
             out += piece
+            status, headers, body = parse_raw(out)
+            if status is not None and "content-length" in headers and len(body) >= int(headers["content-length"]):
+                break
     finally:
         s.close()
     return out
@@ -334,7 +341,9 @@ def parse_raw(data):
     (None, {}, b"") when there is none."""
     if not data.startswith(b"HTTP/1."):
         return None, {}, b""
-    head, _, rest = data.partition(b"\r\n\r\n")
+    head, complete, rest = data.partition(b"\r\n\r\n")
+    if not complete:
+        return None, {}, b""
     lines = head.decode("latin-1").split("\r\n")
     status = int(lines[0].split()[1])
     headers = {}
