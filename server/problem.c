@@ -132,9 +132,10 @@ void gp_problem_store_error(gp_reply *reply, const char *instance, int rc, const
         gp_problem(reply, 503, GP_PROBLEM_STORAGE_FULL, instance,
                    "the database's disk is full: %s. Nothing was lost; try again once an "
                    "administrator has freed space", action);
-    else if (rc == GP_SRV_EREADONLY)
-        gp_problem(reply, 503, GP_PROBLEM_STORAGE_READ_ONLY, instance,
-                   "the database cannot be written (read-only file or file system): %s. "
+    else if (rc == GP_SRV_EUNWRITABLE)
+        gp_problem(reply, 503, GP_PROBLEM_STORAGE_UNWRITABLE, instance,
+                   "the database cannot be written (a read-only file or file system, or a "
+                   "write error): %s. "
                    "Nothing was lost; try again once an administrator has fixed it", action);
     else
         gp_problem(reply, 503, GP_PROBLEM_INTERNAL, instance,

@@ -35,7 +35,7 @@
 #define GP_PROBLEM_HEADERS_TOO_LARGE "urn:grainpack:problem:headers-too-large"
 #define GP_PROBLEM_URI_TOO_LONG "urn:grainpack:problem:uri-too-long"
 #define GP_PROBLEM_STORAGE_FULL "urn:grainpack:problem:storage-full"
-#define GP_PROBLEM_STORAGE_READ_ONLY "urn:grainpack:problem:storage-read-only"
+#define GP_PROBLEM_STORAGE_UNWRITABLE "urn:grainpack:problem:storage-unwritable"
 
 /* Fills reply with a problem: status, type, the standard title of the status and a
  * printf-style detail. `instance` (the request path) may be NULL. Text that came from
@@ -56,7 +56,7 @@ void gp_problem_no_such_process(gp_reply *reply, const char *instance, const cha
 void gp_problem_store_unavailable(gp_reply *reply, const char *instance);
 
 /* The store refused a write (rc from store.h): 503 with Retry-After, saying whether the
- * disk is full (GP_SRV_EFULL), the database cannot be written (GP_SRV_EREADONLY) or it
+ * disk is full (GP_SRV_EFULL), the database cannot be written (GP_SRV_EUNWRITABLE) or it
  * failed otherwise; `action` says what did not happen ("the job was not stored"). */
 void gp_problem_store_error(gp_reply *reply, const char *instance, int rc, const char *action);
 

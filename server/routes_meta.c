@@ -90,7 +90,7 @@ int gp_route_health(gp_request *req, gp_reply *reply)
     int writes = gp_store_write_state(svc->store);
     const char *database = !db_ok                       ? "unavailable"
                            : writes == GP_SRV_EFULL     ? "full"
-                           : writes == GP_SRV_EREADONLY ? "read-only"
+                           : writes == GP_SRV_EUNWRITABLE ? "unwritable"
                                                         : "ok";
     const char *status = !db_ok ? "unavailable" : writes ? "degraded" : "ok";
     int accepting = atomic_load(&svc->accepting);

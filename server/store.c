@@ -102,7 +102,8 @@ struct gp_db {
     sqlite3_stmt *stmt[ST_COUNT_OF];
     sqlite3_stmt *begin, *commit, *rollback;
     int durable;
-    int broken; /* an I/O or permission error: closed when released, not reused */
+    int broken;     /* an I/O or permission error: closed when released, not reused */
+    int generation; /* the store's generation when it was opened */
     gp_db *next_free;
 };
 
@@ -112,8 +113,24 @@ struct gp_store {
     gp_db *free_list[2];  /* idle connections, by durability */
     gp_db **all;          /* every connection open, closed by gp_store_close */
     size_t nall, capall;
-    atomic_int write_state; /* 0, GP_SRV_EFULL or GP_SRV_EREADONLY: the last write's fate */
+    atomic_int write_state; /* 0, GP_SRV_EFULL or GP_SRV_EUNWRITABLE: the last write's fate */
+    /* Moves on when writes start failing and when they work again. A connection opened in
+     * another generation is not reused: one opened while the files could not be written
+     * may stay read-only for good (sqlite opens the WAL read-only and says nothing), and
+     * one opened before may hold what the failure left behind. */
+    atomic_int generation;
 };
+
+/* Records how a write went: a change from working to failing or back starts a new
+ * generation of connections. */
+static void set_write_state(gp_store *store, int state)
+{
+    if (!store)
+        return;
+    int before = atomic_exchange(&store->write_state, state);
+    if ((before == 0) != (state == 0))
+        atomic_fetch_add(&store->generation, 1);
+}
 
 static const char *const status_names[GP_JOB_NSTATUS] = {"accepted", "running", "successful",
                                                           "failed", "dismissed"};
@@ -134,19 +151,21 @@ int gp_job_status_parse(const char *name, gp_job_status *out)
     return GP_EINVAL;
 }
 
-/* What the last failure of db's connection means for the caller: no space (the disk,
- * a quota or the file size limit), no permission to write (read-only file or file
- * system; EPERM is what an immutable file gives), or anything else. */
+/* What the last failure of db's connection means for the caller: no space (sqlite maps
+ * ENOSPC to SQLITE_FULL; a quota or the file size limit come as write errors with their
+ * errno, when sqlite still has it), files that refuse writes (read-only, immutable, or
+ * failing: sqlite's errno is not reliable enough to tell these apart), or anything else. */
 static int classify(gp_db *db)
 {
-    int primary = sqlite3_extended_errcode(db->conn) & 0xff;
+    int ext = sqlite3_extended_errcode(db->conn), primary = ext & 0xff;
     int sys = sqlite3_system_errno(db->conn);
     if (primary == SQLITE_FULL || (primary == SQLITE_IOERR && (sys == ENOSPC || sys == EDQUOT ||
                                                                 sys == EFBIG)))
         return GP_SRV_EFULL;
-    if (primary == SQLITE_READONLY ||
-        (primary == SQLITE_IOERR && (sys == EROFS || sys == EPERM || sys == EACCES)))
-        return GP_SRV_EREADONLY;
+    if (primary == SQLITE_READONLY || ext == SQLITE_IOERR_WRITE || ext == SQLITE_IOERR_FSYNC ||
+        ext == SQLITE_IOERR_DIR_FSYNC || ext == SQLITE_IOERR_TRUNCATE ||
+        ext == SQLITE_IOERR_SHMSIZE || ext == SQLITE_IOERR_SHMOPEN)
+        return GP_SRV_EUNWRITABLE;
     return GP_SRV_EDB;
 }
 
@@ -162,8 +181,8 @@ static int db_fail(gp_db *db, const char *what)
     if (primary == SQLITE_IOERR || primary == SQLITE_READONLY || primary == SQLITE_CORRUPT ||
         primary == SQLITE_CANTOPEN)
         db->broken = 1;
-    if (rc != GP_SRV_EDB && db->store)
-        atomic_store(&db->store->write_state, rc);
+    if (rc != GP_SRV_EDB)
+        set_write_state(db->store, rc);
     return rc;
 }
 
@@ -248,8 +267,7 @@ static int begin(gp_db *db)
 static int commit(gp_db *db)
 {
     if (step_simple(db->commit) == 0) {
-        if (db->store)
-            atomic_store(&db->store->write_state, 0);
+        set_write_state(db->store, 0);
         return 0;
     }
     int rc = db_fail(db, "commit");
@@ -392,6 +410,11 @@ gp_db *gp_store_acquire(gp_store *store, int durable)
     if (db)
         store->free_list[durable] = db->next_free;
     pthread_mutex_unlock(&store->lock);
+    if (db && gp_store_broken(db)) { /* from another generation: a fresh one instead */
+        db->broken = 1;
+        gp_store_release(store, db);
+        db = NULL;
+    }
     if (db)
         return db;
     char why[256];
@@ -401,6 +424,7 @@ gp_db *gp_store_acquire(gp_store *store, int durable)
         return NULL;
     }
     db->store = store;
+    db->generation = atomic_load(&store->generation);
     pthread_mutex_lock(&store->lock);
     int rc = remember(store, db);
     pthread_mutex_unlock(&store->lock);
@@ -416,7 +440,7 @@ void gp_store_release(gp_store *store, gp_db *db)
     if (!db)
         return;
     rollback(db); /* a caller that bailed out mid-transaction must not hold the write lock */
-    if (db->broken) {
+    if (gp_store_broken(db)) {
         pthread_mutex_lock(&store->lock);
         for (size_t i = 0; i < store->nall; i++) {
             if (store->all[i] == db) {
@@ -944,7 +968,7 @@ int gp_store_write_state(gp_store *store)
 
 int gp_store_broken(const gp_db *db)
 {
-    return db && db->broken;
+    return db && (db->broken || db->generation != atomic_load(&db->store->generation));
 }
 
 int gp_store_healthy(gp_db *db)

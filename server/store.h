@@ -19,8 +19,8 @@ enum {
     GP_SRV_ESTATE = -101,    /* the job is not in the state the operation needs */
     GP_SRV_EDB = -102,       /* sqlite failed; the log has its message */
     GP_SRV_EFULL = -103,     /* the disk (or the file size limit) is full: nothing was written */
-    GP_SRV_EREADONLY = -104, /* the database cannot be written (read-only file or file
-                                system, permission): nothing was written */
+    GP_SRV_EUNWRITABLE = -104, /* the database cannot be written (a read-only file or file
+                                  system, or a write error): nothing was written */
     GP_SRV_ELIMIT = -105     /* the owner has as many active jobs as allowed */
 };
 
@@ -75,9 +75,10 @@ void gp_store_close(gp_store *store);
 gp_db *gp_store_acquire(gp_store *store, int durable);
 void gp_store_release(gp_store *store, gp_db *db);
 
-/* Write failures: every function that writes returns GP_SRV_EFULL or GP_SRV_EREADONLY
- * when sqlite could not write for lack of space or of permission (the transaction is
- * rolled back: nothing half-written stays), GP_SRV_EDB for any other failure.
+/* Write failures: every function that writes returns GP_SRV_EFULL when sqlite could not
+ * write for lack of space, GP_SRV_EUNWRITABLE when the files refused the write (read-only,
+ * or an I/O error on writing), GP_SRV_EDB for any other failure; the transaction is then
+ * rolled back, so nothing half-written stays.
  *
  * Owners: functions taking `owner` see only that owner's jobs ("" is the owner of jobs
  * submitted without a key); NULL sees every job (an admin, or a daemon without keys).
@@ -146,12 +147,13 @@ int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS]);
 int gp_store_healthy(gp_db *db);
 
 /* How the last write went: 0 (it succeeded, or none failed yet), GP_SRV_EFULL or
- * GP_SRV_EREADONLY. Any successful write sets it back to 0. */
+ * GP_SRV_EUNWRITABLE. Any successful write sets it back to 0. */
 int gp_store_write_state(gp_store *store);
 
-/* Whether the connection hit an I/O or permission error: a worker holding a connection
- * for long gives it back (gp_store_release closes it) and takes a fresh one, which sees
- * the file as it is now (writable again, say). */
+/* Whether the connection should not be used again: it hit an I/O or permission error,
+ * or writes started failing or working again since it was opened. A worker holding a
+ * connection for long then gives it back (gp_store_release closes it) and takes a fresh
+ * one, which sees the files as they are now (writable again, say). */
 int gp_store_broken(const gp_db *db);
 
 #endif

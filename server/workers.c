@@ -35,7 +35,7 @@
  * cancel-check interval. */
 #define WATCHDOG_SECONDS 0.1
 
-/* When the outcome of a job cannot be stored (disk full, read-only database), the worker
+/* When the outcome of a job cannot be stored (disk full, database not writable), the worker
  * keeps it and tries again after this many seconds, doubling up to the maximum: a
  * result is never dropped while the daemon runs, and a stop leaves the job running in
  * the store, to be queued again at the next start. */
@@ -182,7 +182,7 @@ static int persist(worker *w, const char *id, outcome_kind kind, const gp_result
                 gp_log("job %s: cannot store its outcome (%s); the worker keeps it and tries "
                        "again until the database can be written",
                        id, rc == GP_SRV_EFULL       ? "the disk is full"
-                           : rc == GP_SRV_EREADONLY ? "the database is read-only"
+                           : rc == GP_SRV_EUNWRITABLE ? "the database cannot be written"
                                                     : "store error");
             struct timespec ts = realtime_in(delay);
             pthread_cond_timedwait(&pool->retry, &pool->lock, &ts);

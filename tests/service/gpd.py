@@ -162,11 +162,13 @@ class Client:
 class Daemon:
     """grainpackd in a temporary data directory, on a port it picks itself."""
 
-    def __init__(self, binary, *args, data_dir=None, env=None):
+    def __init__(self, binary, *args, data_dir=None, env=None, log_dir=None, wrapper=()):
         self.binary = binary
         self.args = list(args)
         self.own_dir = data_dir is None
         self.dir = data_dir or tempfile.mkdtemp(prefix="grainpackd-test-")
+        self.log_dir = log_dir or self.dir  # elsewhere when the data directory may fill up
+        self.wrapper = list(wrapper)
         self.db_path = os.path.join(self.dir, "grainpack.db")
         self.env = dict(os.environ, **(env or {}))
         self.proc = None
@@ -179,10 +181,10 @@ class Daemon:
         if os.path.exists(ready):
             os.unlink(ready)
         self.runs += 1
-        self.log_path = os.path.join(self.dir, f"daemon-{self.runs}.log")
+        self.log_path = os.path.join(self.log_dir, f"daemon-{self.runs}.log")
         log = open(self.log_path, "w")
         self.proc = subprocess.Popen(
-            [self.binary, "--port", "0", "--data-dir", self.dir, "--ready-file", ready] + self.args,
+            self.wrapper + [self.binary, "--port", "0", "--data-dir", self.dir, "--ready-file", ready] + self.args,
             stdout=log, stderr=log, env=self.env)
         log.close()
         deadline = time.monotonic() + STARTUP_LIMIT
@@ -227,6 +229,16 @@ class Daemon:
         """A read-only connection to the daemon's database file."""
         return sqlite3.connect(f"file:{self.db_path}?mode=ro", uri=True, timeout=30)
 
+    def wait_log(self, text, count=1, limit=JOB_LIMIT):
+        """Waits until the log holds text (count times); a broken run fails after limit."""
+        deadline = time.monotonic() + limit
+        while self.log().count(text) < count:
+            if self.proc is not None and self.proc.poll() is not None:
+                raise AssertionError(f"grainpackd exited with {self.proc.returncode}:\n{self.log()[-3000:]}")
+            if time.monotonic() > deadline:
+                raise AssertionError(f"the log never said {text!r}:\n{self.log()[-3000:]}")
+            time.sleep(0.02)
+
     def cleanup(self):
         if self.proc is not None:
             self.kill()
@@ -234,6 +246,30 @@ class Daemon:
             for name in os.listdir(self.dir):
                 os.unlink(os.path.join(self.dir, name))
             os.rmdir(self.dir)
+
+
+def check_store(checks, daemon, what):
+    """The database file is sound and holds no half-written result: integrity_check is
+    ok; every successful job has its disks (32 bytes each, as many as its count), its
+    per-bin statistics and its stage timings; no other job has a result. Returns the
+    {id: status} of every job."""
+    db = daemon.db()
+    try:
+        checks.check(db.execute("PRAGMA integrity_check").fetchone()[0] == "ok", f"{what}: integrity_check")
+        bad = db.execute(
+            "SELECT j.id, j.status, j.count, r.count, length(r.disks),"
+            " (SELECT count(*) FROM bin_stats b WHERE b.job_id = j.id),"
+            " (SELECT count(*) FROM stage_timings t WHERE t.job_id = j.id)"
+            " FROM jobs j LEFT JOIN results r ON r.job_id = j.id"
+            " WHERE (j.status = 'successful' AND (r.count IS NULL OR r.count != j.count"
+            "   OR length(r.disks) != 32 * j.count"
+            "   OR NOT EXISTS (SELECT 1 FROM bin_stats b WHERE b.job_id = j.id)"
+            "   OR NOT EXISTS (SELECT 1 FROM stage_timings t WHERE t.job_id = j.id)))"
+            " OR (j.status != 'successful' AND r.job_id IS NOT NULL)").fetchall()
+        checks.check(not bad, f"{what}: jobs with a half-written or stray result: {bad[:5]}")
+        return dict(db.execute("SELECT id, status FROM jobs").fetchall())
+    finally:
+        db.close()  # (a `with` block would leave it open)
 
 
 class OpenAPI:

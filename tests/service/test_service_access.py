@@ -42,14 +42,6 @@ def append_keys(path, users):
     return keys
 
 
-def wait_log(daemon, text, count=1):
-    deadline = time.monotonic() + gpd.STARTUP_LIMIT
-    while daemon.log().count(text) < count:
-        if time.monotonic() > deadline:
-            raise AssertionError(f"log never said {text!r}:\n{daemon.log()[-2000:]}")
-        time.sleep(0.02)
-
-
 def check_unauthorized(c, api, what, r, method, template, error=None):
     c.check(r.status == 401 and r.content_type == "application/problem+json",
             f"{what}: {r}")
@@ -139,7 +131,7 @@ def test_keys(c, api, binary):
         with open(key_file, "a") as f:
             f.writelines(root_line)
         daemon.proc.send_signal(signal.SIGHUP)
-        wait_log(daemon, "3 API keys read again")
+        daemon.wait_log("3 API keys read again")
         bob_old, bob_new, carol = daemon.client(keys["bob"]), daemon.client(new["bob"]), daemon.client(new["carol"])
         check_unauthorized(c, api, "bob's old key after rotation", bob_old.get("/jobs"), "GET", "/jobs")
         check_unauthorized(c, api, "alice's revoked key", alice.get("/jobs"), "GET", "/jobs")
@@ -150,7 +142,7 @@ def test_keys(c, api, binary):
         with open(key_file, "a") as f:
             f.write("sha256:nothex dave user\n")
         daemon.proc.send_signal(signal.SIGHUP)
-        wait_log(daemon, "the previous keys stay in use")
+        daemon.wait_log("the previous keys stay in use")
         c.check(f"{key_file}:4: " in daemon.log(), "the reload error names the line")
         c.check(carol.get("/jobs").status == 200, "carol after a broken reload")
         for client in (anon, alice, bob, root, bob_old, bob_new, carol):
