@@ -243,9 +243,7 @@ class Daemon:
         if self.proc is not None:
             self.kill()
         if self.own_dir:
-            for name in os.listdir(self.dir):
-                os.unlink(os.path.join(self.dir, name))
-            os.rmdir(self.dir)
+            remove_tree(self.dir)
 
 
 def check_store(checks, daemon, what):
@@ -327,6 +325,27 @@ class OpenAPI:
 
 
 RFC3339 = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?Z$")
+
+
+def check_problem(checks, r, status, ptype, word, what, retry_after=False):
+    """Checks that r is a problem+json of this status and type whose detail says `word`
+    (and that has a Retry-After, when asked); returns whether it is."""
+    ok = checks.check(r is not None and r.status == status and r.content_type == "application/problem+json",
+                      f"{what}: {r}")
+    if ok:
+        p = r.json()
+        ok = checks.check(p.get("type") == ptype and p.get("status") == status and word in p.get("detail", ""),
+                          f"{what}: {p}")
+        if retry_after:
+            ok &= checks.check(int(r.headers.get("retry-after", 0)) > 0, f"{what}: no Retry-After")
+    return ok
+
+
+def remove_tree(directory):
+    """Removes a test's temporary directory and the files in it."""
+    for name in os.listdir(directory):
+        os.unlink(os.path.join(directory, name))
+    os.rmdir(directory)
 
 
 def write_keys(path, users):

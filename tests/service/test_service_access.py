@@ -160,9 +160,7 @@ def test_keys(c, api, binary):
             broken.cleanup()
     finally:
         daemon.cleanup()
-        for name in os.listdir(directory):
-            os.unlink(os.path.join(directory, name))
-        os.rmdir(directory)
+        gpd.remove_tree(directory)
 
 
 def test_open_mode(c, binary):

@@ -89,11 +89,8 @@ def test(c, binary):
                 continue
             full = r
             break
-        c.check(full is not None and full.status == 503, f"no 503 after {len(accepted)} submissions: {full}")
-        if full is not None and full.status == 503:
-            p = full.json()
-            c.check(p["type"] == "urn:grainpack:problem:storage-full" and "disk is full" in p["detail"]
-                    and int(full.headers.get("retry-after", 0)) > 0, f"the 503: {p} {full.headers}")
+        if gpd.check_problem(c, full, 503, "urn:grainpack:problem:storage-full", "disk is full",
+                             f"after {len(accepted)} submissions on a full disk", retry_after=True):
             api.check(c, "POST", "/processes/{processId}/execution", full)
         health = client.get("/health")
         c.check(health.status == 200 and health.json()["status"] == "degraded"

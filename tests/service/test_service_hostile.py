@@ -334,9 +334,7 @@ def test(c, binary):
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:
         daemon.cleanup()
-        for name in os.listdir(directory):
-            os.unlink(os.path.join(directory, name))
-        os.rmdir(directory)
+        gpd.remove_tree(directory)
 
 
 if __name__ == "__main__":

@@ -19,11 +19,7 @@ HEADER_CAP = 2048
 
 
 def problem(c, r, status, ptype, word, what):
-    ok = c.check(r.status == status and r.content_type == "application/problem+json", f"{what}: {r}")
-    if ok:
-        p = r.json()
-        c.check(p["type"] == ptype and p["status"] == status and word in p["detail"], f"{what}: {p}")
-    return ok
+    return gpd.check_problem(c, r, status, ptype, word, what)
 
 
 def closed_by_daemon(sock, limit=gpd.STARTUP_LIMIT):

@@ -70,11 +70,8 @@ def test(c, binary):
             if r.status != 201:
                 refused = r
                 break
-        c.check(refused is not None and refused.status == 503, f"no 503 on a read-only database: {refused}")
-        if refused is not None and refused.status == 503:
-            p = refused.json()
-            c.check(p["type"] == "urn:grainpack:problem:storage-unwritable" and "cannot be written" in p["detail"]
-                    and int(refused.headers.get("retry-after", 0)) > 0, f"the 503: {p}")
+        if gpd.check_problem(c, refused, 503, "urn:grainpack:problem:storage-unwritable", "cannot be written",
+                             "a submission to a read-only database", retry_after=True):
             api.check(c, "POST", "/processes/{processId}/execution", refused)
         health = client.get("/health").json()
         c.check(health["status"] == "degraded" and health["database"] == "unwritable", f"health: {health}")
@@ -96,9 +93,7 @@ def test(c, binary):
     finally:
         chattr("-i", *[f for f in files if os.path.exists(f)])
         daemon.cleanup()
-        for name in os.listdir(directory):
-            os.unlink(os.path.join(directory, name))
-        os.rmdir(directory)
+        gpd.remove_tree(directory)
 
 
 if __name__ == "__main__":
