@@ -46,7 +46,7 @@ typedef struct request_state {
     size_t discarded;
     int answered;    /* a response was queued */
     int suspended;   /* a long-poll is waiting */
-    char method[8], path[200]; /* for the log line, sanitized */
+    char method[16], path[200]; /* for the log line, sanitized */
     unsigned status;
     size_t bytes;
     double t0;
@@ -203,7 +203,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             return MHD_NO;
         *con_cls = st;
         st->t0 = gp_monotonic_seconds();
-        snprintf(st->method, sizeof st->method, "%s", method);
+        gp_text_sanitize(st->method, sizeof st->method, method);
         gp_text_sanitize(st->path, sizeof st->path, url);
         return begin_request(svc, conn, url, method, st);
     }
