@@ -1,0 +1,67 @@
+/* store_db.h - inside the job store (store*.c only): a connection with its prepared
+ * statements, and the helpers every query uses. Not for the rest of the service. */
+#ifndef GRAINPACKD_STORE_DB_H
+#define GRAINPACKD_STORE_DB_H
+
+#include <sqlite3.h>
+
+#include "store.h"
+
+enum stmt_id {
+    ST_INSERT,
+    ST_GET,
+    ST_LIST,
+    ST_CLAIM,
+    ST_PROGRESS,
+    ST_FINISH,
+    ST_RESULT,
+    ST_BIN,
+    ST_TIMING,
+    ST_FAIL,
+    ST_REQUEUE,
+    ST_STATUS,
+    ST_DISMISS,
+    ST_DELETE,
+    ST_LOAD,
+    ST_TIMINGS,
+    ST_COUNT,
+    ST_ACTIVE,
+    ST_COUNT_OF
+};
+
+struct gp_db {
+    gp_store *store;
+    sqlite3 *conn;
+    sqlite3_stmt *stmt[ST_COUNT_OF];
+    sqlite3_stmt *begin, *commit, *rollback;
+    int durable;
+    int broken;     /* an I/O or permission error: closed when released, not reused */
+    int generation; /* the store's generation when it was opened */
+    gp_db *next_free;
+};
+
+/* The statement `id` of db, prepared on first use, reset and unbound; NULL (logged, as
+ * gp_db_fail) when sqlite cannot prepare it. Owned by db. */
+sqlite3_stmt *gp_db_stmt(gp_db *db, enum stmt_id id);
+
+/* Steps s once and resets it: 0 (a row or done) or GP_SRV_EDB. */
+int gp_db_step(sqlite3_stmt *s);
+
+/* Logs db's last failure with `what` and returns its class: GP_SRV_EFULL,
+ * GP_SRV_EUNWRITABLE or GP_SRV_EDB. A connection that met an I/O or permission error is
+ * marked broken (closed when released), and the store's write state follows. */
+int gp_db_fail(gp_db *db, const char *what);
+
+/* BEGIN IMMEDIATE, COMMIT (rolls back when it fails), ROLLBACK (only inside a
+ * transaction); the first two return 0 or a class of gp_db_fail. */
+int gp_db_begin(gp_db *db);
+int gp_db_commit(gp_db *db);
+void gp_db_rollback(gp_db *db);
+
+/* Copies the text of column col (empty when NULL) into dst, truncated to size. */
+void gp_db_copy_text(char *dst, size_t size, sqlite3_stmt *s, int col);
+
+/* Binds owner to parameter i: the name, or NULL (the statement then matches any owner). */
+void gp_db_bind_owner(sqlite3_stmt *s, int i, const char *owner);
+
+#endif
