@@ -46,7 +46,7 @@ static void new_job_id(char out[GP_JOB_ID_SIZE])
              b[15]);
 }
 
-/* Reads a row of JOB_COLUMNS. */
+/* Reads a row of JOB_COLUMNS (store.c: the columns of ST_GET and ST_LIST). */
 static void read_job(sqlite3_stmt *s, gp_job *job)
 {
     memset(job, 0, sizeof *job);
