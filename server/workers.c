@@ -25,9 +25,9 @@
  * by a previous run of the daemon, or a notification that another worker consumed). */
 #define IDLE_RECHECK_SECONDS 1
 
-/* Niceness of the worker threads: packing yields the processors to the HTTP threads, so
- * that status requests stay fast while every worker is busy (on Linux, nice is per
- * thread). Workers still take all the time the HTTP side leaves. */
+/* Niceness of the worker threads where SCHED_IDLE is refused (under SCHED_IDLE the kernel
+ * ignores nice): packing still yields the processors to the HTTP threads, less promptly
+ * (on Linux, nice is per thread). Workers take all the time the HTTP side leaves. */
 #define WORKER_NICE 19
 
 /* The watchdog looks at the running jobs at least this often (it also wakes when a job
@@ -300,9 +300,9 @@ static void *worker_main(void *arg)
      * and nice 19 the kernel's scheduler (EEVDF) lets the worker finish its slice first:
      * GET p99 8.7-11.5 ms while both workers packed, against 7.9-10.0 ms with SCHED_IDLE
      * (bench/service.sh, 2 cores). The price: under a request load that fills every core,
-     * workers get less time (bench/load.sh: 2181-2204 jobs a minute, against 2509-2581). */
+     * workers get less time (bench/load.sh: 2181-2244 jobs a minute, against 2509-2581). */
     struct sched_param idle = {0};
-    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0 ||
+    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0 &&
         setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), WORKER_NICE) != 0)
         gp_log("worker: cannot lower its priority; requests may wait behind packing");
     for (;;) {
