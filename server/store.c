@@ -275,7 +275,7 @@ static int requeue_running(gp_db *db, int *requeued, char *why, size_t why_size)
     gp_timestamp_now(now);
     snprintf(sql, sizeof sql,
              "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
-             " message = 'queued again: the daemon stopped while it ran', updated = '%s'"
+             " message = '" GP_REQUEUE_MESSAGE "', updated = '%s'"
              " WHERE status = 'running'",
              now);
     if (exec_sql(db->conn, "BEGIN IMMEDIATE", why, why_size) ||

@@ -40,6 +40,10 @@ struct gp_db {
     gp_db *next_free;
 };
 
+/* The message of a job that was running when the daemon stopped, queued again (at
+ * shutdown, or at the next start after a crash). No quote in it: store.c puts it in SQL. */
+#define GP_REQUEUE_MESSAGE "queued again: the daemon stopped while it ran"
+
 /* The statement `id` of db, prepared on first use, reset and unbound; NULL (logged, as
  * gp_db_fail) when sqlite cannot prepare it. Owned by db. */
 sqlite3_stmt *gp_db_stmt(gp_db *db, enum stmt_id id);

@@ -276,8 +276,7 @@ int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *
 
 int gp_store_requeue(gp_db *db, const char *id)
 {
-    return update_running(db, ST_REQUEUE, id, "queued again: the daemon stopped while it ran",
-                          NULL, "requeue job");
+    return update_running(db, ST_REQUEUE, id, GP_REQUEUE_MESSAGE, NULL, "requeue job");
 }
 
 int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
