@@ -105,7 +105,7 @@ static void seed_average(const gp_spec *spec, uint32_t band, int seeds, double *
 
 static const struct {
     const char *name;
-    const char *report; /* the report's figures (SPEC §3.6) */
+    const char *report; /* the report's figures (docs/method.md §3.6) */
 } cases[] = {
     {"fixed", "2789 / 0.8762 / 0.04 s"},
     {"variable", "1217 / 0.8019 / 0.02 s"},
@@ -177,7 +177,7 @@ static void bench_report_sampling(const char *dir, int seeds)
                     gp_packing_free(&pk);
                 }
                 printf("| %s | %u | %s | %.0f | %.4f |\n", names[c], band,
-                       same ? "report (r' = r)" : "independent (SPEC)", disks, density);
+                       same ? "report (r' = r)" : "independent (ours)", disks, density);
             }
         }
         gp_spec_free(&spec);

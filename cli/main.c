@@ -8,24 +8,28 @@
 #include "grainpack/io.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
+#include "grainpack/version.h"
 
 /* Exit statuses, documented in usage(). */
 enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2, EXIT_BAD_SPEC = 3 };
 
 static void usage(FILE *out)
 {
-    fputs("usage: grainpack run SPEC.json [--format json|csv|svg|vtk] [-o FILE] [--max-disks N]\n"
-          "       grainpack validate SPEC.json [--max-disks N]\n"
-          "       grainpack --help | --version\n"
+    fputs("Usage: grainpack run SPEC.json [--format json|csv|svg|vtk] [-o FILE] [--max-disks N]\n"
+          "  or:  grainpack validate SPEC.json [--max-disks N]\n"
+          "  or:  grainpack --help | --version\n"
           "\n"
-          "run       packs the domain the spec describes, balances it and builds its\n"
-          "          Laguerre cells when the spec asks (\"balance\", \"laguerre\"), and writes\n"
-          "          the result (default JSON with statistics, to standard output). SPEC.json\n"
-          "          is the job spec, either {\"inputs\": {...}} or the bare inputs object;\n"
-          "          '-' reads stdin.\n"
-          "validate  checks a spec and prints the expected number of disks.\n"
+          "  run       packs the domain the spec describes, balances it and builds its\n"
+          "            Laguerre cells when the spec asks (\"balance\", \"laguerre\"), and\n"
+          "            writes the result (default JSON with statistics, to standard output).\n"
+          "            SPEC.json is the job spec, either {\"inputs\": {...}} or the bare\n"
+          "            inputs object; '-' reads stdin.\n"
+          "  validate  checks a spec and prints the expected number of disks.\n"
           "\n"
-          "--max-disks N  refuse specs expected to need more than N disks (default 20000000)\n"
+          "  -f, --format FORMAT  json (default), csv, svg or vtk\n"
+          "  -o FILE              write to FILE instead of standard output\n"
+          "  --max-disks N        refuse specs expected to need more than N disks\n"
+          "                       (default 20000000)\n"
           "\n"
           "Progress goes to standard error when it is a terminal.\n"
           "Exit status: 0 success, 1 the run failed, 2 usage error, 3 invalid spec.\n",

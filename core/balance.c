@@ -1,4 +1,4 @@
-/* balance.c - the quality criterion F and the two balancing methods of SPEC §4: sweeps
+/* balance.c - the quality criterion F and the two balancing methods of docs/method.md §4: sweeps
  * that move each interior centre a step toward a target (the barycentre of its neighbours,
  * or of the positions tangent to its ball's boundary edges), refused when the step would
  * overlap a disk or leave the domain. */
@@ -49,7 +49,7 @@ static size_t ring_of(const gp_rt *rt, int32_t id, ring_buffer *buf, int *on_hul
     }
 }
 
-/* F(p) of SPEC §4.2 for the disk p with the given ring. */
+/* F(p) of docs/method.md §4.2 for the disk p with the given ring. */
 static double quality_of(const gp_disk *disks, const gp_disk *p, const int32_t *ring,
                          size_t degree)
 {
@@ -163,7 +163,7 @@ static int position_is_free(const balancer *b, int32_t id, double x, double y)
 }
 
 /* The target of an interior centre: for relocation, the barycentre of the conflict-free
- * positions tangent to the boundary edges of its ball (SPEC §4.4); for Laplacian
+ * positions tangent to the boundary edges of its ball (docs/method.md §4.4); for Laplacian
  * smoothing, the barycentre of its neighbours. Returns 0 when there is none. */
 static int target_of(const balancer *b, int32_t id, const int32_t *ring, size_t degree,
                      double *tx, double *ty)

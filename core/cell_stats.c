@@ -1,4 +1,4 @@
-/* cell_stats.c - statistics of the Laguerre cells (SPEC §5): areas, neighbour counts, the
+/* cell_stats.c - statistics of the Laguerre cells (docs/method.md §5): areas, neighbour counts, the
  * grain-boundary band and the equivalent radii against the target law. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* distribution.c - radius laws: sampling (SPEC §2), support, moments, report bins. */
+/* distribution.c - radius laws: sampling (docs/method.md §2), support, moments, report bins. */
 #include "grainpack/distribution.h"
 
 #include <stdlib.h>

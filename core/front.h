@@ -5,7 +5,7 @@
  * segment u -> u.next of node u has the filled region on its right. A disk can sit on
  * several loops (where a loop was pinched in two), once per node.
  *
- * Segments waiting to be worked sit in one bucket per level (SPEC §3.3): the untried ones
+ * Segments waiting to be worked sit in one bucket per level (docs/method.md §3.3): the untried ones
  * in a list, newest first, and the ones that failed in lists by the radius they failed
  * for, quantised into FRONT_FAIL_CLASSES classes over the law's range with a bit mask of
  * the classes in use. "The next segment of a level that has not failed for a radius <= R"
@@ -125,7 +125,7 @@ int front_place(front *f, int32_t u, int32_t c, int c_touches_b);
 /* The node of `disk` on the same loop as node u, or FRONT_NONE. */
 int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u);
 
-/* Closes the front at node u's segment (p1, p2) on node w of the same loop (SPEC §3.5):
+/* Closes the front at node u's segment (p1, p2) on node w of the same loop (docs/method.md §3.5):
  * the segment is replaced by p1 -> pk -> p2, which cuts an ear off the loop when pk is
  * next to p1 or p2, and splits the loop in two otherwise. Loops left with fewer than
  * three nodes enclose nothing and go. Returns 0 or GP_ENOMEM. */

@@ -1,4 +1,4 @@
-/* grid.c - bucket grid for neighbour queries (SPEC §3.4). */
+/* grid.c - bucket grid for neighbour queries (docs/method.md §3.4). */
 #include "grainpack/grid.h"
 
 #include <math.h>

@@ -1,4 +1,4 @@
-/* laguerre.c - power cells clipped to the domain and shrunk (SPEC §5). A cell is built by
+/* laguerre.c - power cells clipped to the domain and shrunk (docs/method.md §5). A cell is built by
  * cutting the domain rectangle with the radical half-plane of each triangulation neighbour
  * (Sutherland-Hodgman on a convex polygon), in coordinates relative to the centre so that
  * every vertex is accurate to a few ulps of the grain's size wherever the grain lies. */
@@ -245,7 +245,7 @@ static int record_neighbours(builder *bd, int32_t i)
     return 0;
 }
 
-/* Shrinks the cell in bd->a (SPEC §5). */
+/* Shrinks the cell in bd->a (docs/method.md §5). */
 static void shrink(builder *bd, const gp_disk *p)
 {
     polygon *a = &bd->a;

@@ -1,4 +1,4 @@
-/* pack.c - the advancing-front disk packer of SPEC §3 (report §III, Algorithm 1).
+/* pack.c - the advancing-front disk packer of docs/method.md §3 (report §III, Algorithm 1).
  *
  * Disks are laid along the boundary (the initial front), then placed one at a time
  * tangent to the two disks of a front segment, lowest level first, with the radius drawn
@@ -128,7 +128,7 @@ static int front_oom(packer *pk)
     return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the front");
 }
 
-/* ---- the initial front (SPEC §3.2) ---- */
+/* ---- the initial front (docs/method.md §3.2) ---- */
 
 static int build_initial_front(packer *pk)
 {
@@ -240,7 +240,7 @@ static int build_initial_front(packer *pk)
     return rc;
 }
 
-/* ---- the loop (SPEC §3.5) ---- */
+/* ---- the loop (docs/method.md §3.5) ---- */
 
 /* The disks of node u's segment. */
 static int32_t seg_from(const packer *pk, int32_t u)
@@ -254,7 +254,7 @@ static int32_t seg_to(const packer *pk, int32_t u)
 }
 
 /* Where a disk of radius R goes against node u's segment (a, b): tangent to both on the
- * empty side (SPEC §3.1, as gp_place_tangent); or, when the two are further apart than the
+ * empty side (docs/method.md §3.1, as gp_place_tangent); or, when the two are further apart than the
  * disk can bridge and `bridge_gap` is set, touching a with its centre on the segment, so
  * that the gap is filled from one end rather than given up. Returns 1 with the centre when the position
  * exists and fits. The disk that was in the way last time, then the disks next to a and b
@@ -267,7 +267,7 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     const front_node *n = &nodes[u];
     int32_t a = n->disk, b = nodes[n->next].disk;
     const gp_disk *da = &pk->disks[a], *db = &pk->disks[b];
-    /* SPEC §3.1 with the segment's direction and length computed once per segment */
+    /* docs/method.md §3.1 with the segment's direction and length computed once per segment */
     double ra = da->R + R, rb = db->R + R, d = n->length;
     *touches_b = !(d > ra + rb);
     if (!*touches_b) {
@@ -388,7 +388,7 @@ static int32_t closing_node(const packer *pk, size_t n, int32_t u)
 }
 
 /* Nothing in the front's level band takes the pending radius: close the front at node u's
- * segment (p1, p2) (SPEC §3.5, our eq. 7), on the node chosen by closing_node among the
+ * segment (p1, p2) (docs/method.md §3.5, our eq. 7), on the node chosen by closing_node among the
  * disks the radius met when placed against it. When it met none of the loop (only the
  * wall, or disks the front has passed) or the two disks are too far apart for it, the
  * segment is frozen and the pocket behind it stays a void. */

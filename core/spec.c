@@ -375,7 +375,7 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
         spec->balance.max_iterations = (uint32_t)n;
     }
     if (json_object_get(obj, "max_step")) {
-        /* the steps tried go down by 0.05 to 0.05 (SPEC §4.4): a smaller first step tries none */
+        /* the steps tried go down by 0.05 to 0.05 (docs/method.md §4.4): a smaller first step tries none */
         if ((rc = get_number(v, obj, ptr, "max_step", 0.05, 1, &spec->balance.max_step)))
             return rc;
         if (spec->balance.max_step > 1.0) {

@@ -7,6 +7,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "grainpack/version.h"
+
 #define DEFAULT_MAX_BODY ((size_t)1 << 20)
 #define DEFAULT_MAX_QUEUED ((size_t)10000)
 /* A job this size packs in a few seconds and its result (32 bytes a disk) stays
@@ -99,7 +101,7 @@ static const option options[] = {
 
 static void usage(FILE *out)
 {
-    fputs("usage: grainpackd [OPTION VALUE]...\n"
+    fputs("Usage: grainpackd [OPTION VALUE]...\n"
           "The grainpack job service: OGC API - Processes over HTTP, jobs in sqlite.\n\n",
           out);
     for (size_t i = 0; i < NOPTIONS; i++)

@@ -13,6 +13,7 @@
 
 #include "auth.h"
 #include "config.h"
+#include "grainpack/version.h"
 #include "http.h"
 #include "log.h"
 #include "peers.h"

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "embedded.h"
+#include "grainpack/version.h"
 #include "log.h"
 #include "problem.h"
 #include "routes.h"

@@ -204,7 +204,7 @@ static void test_both_methods_keep_every_promise_on_the_reference_cases(void)
 
 static void test_relocation_beats_the_report_on_the_fixed_case(void)
 {
-    /* the report: F_max 1.962 before, 1.33 after its relocation (SPEC §4.2) */
+    /* the report: F_max 1.962 before, 1.33 after its relocation (docs/method.md §4.2) */
     gp_spec spec;
     load_example("fixed", &spec);
     summary s = check_balance(&spec, 1, GP_BALANCE_RELOCATION, "fixed");

@@ -75,7 +75,7 @@ grep -q "expected json, csv, svg or vtk" "$tmp/err" || fail "unknown format mess
 "$bin" frobnicate 2> /dev/null; [ $? -eq 2 ] || fail "unknown command"
 "$bin" run 2> /dev/null; [ $? -eq 2 ] || fail "missing spec"
 "$bin" run "$examples/iron.json" --max-disks -5 2> /dev/null; [ $? -eq 2 ] || fail "negative cap"
-"$bin" --help | grep -q "usage: grainpack run" || fail "--help"
+"$bin" --help | grep -q "Usage: grainpack run" || fail "--help"
 
 # a missing file: exit 1 with the reason
 "$bin" run "$tmp/nope.json" 2> "$tmp/err"

@@ -11,7 +11,7 @@
  * sampler would have to be to fail. */
 #define SIGNIFICANCE 0.001
 
-/* The report's Table 1 histogram (SPEC §2). */
+/* The report's Table 1 histogram (docs/method.md §2). */
 static const double table1_p[10] = {0.15, 0.2, 0.1, 0.05, 0.13, 0.09, 0.08, 0.07, 0.05, 0.08};
 
 static gp_distribution table1(void)

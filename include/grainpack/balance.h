@@ -1,4 +1,4 @@
-/* balance.h - balancing the free space around the grains (SPEC §4, report §IV): the
+/* balance.h - balancing the free space around the grains (docs/method.md §4, report §IV): the
  * quality criterion F(p), constrained Laplacian smoothing (Algorithm 2) and the report's
  * relocation (Algorithm 3). */
 #ifndef GRAINPACK_BALANCE_H
@@ -19,8 +19,8 @@ extern "C" {
 
 typedef enum gp_balance_method {
     GP_BALANCE_NONE = 0,   /* measure F only */
-    GP_BALANCE_LAPLACIAN,  /* constrained Laplacian smoothing (SPEC §4.3), the baseline */
-    GP_BALANCE_RELOCATION  /* the report's relocation (SPEC §4.4) */
+    GP_BALANCE_LAPLACIAN,  /* constrained Laplacian smoothing (docs/method.md §4.3), the baseline */
+    GP_BALANCE_RELOCATION  /* the report's relocation (docs/method.md §4.4) */
 } gp_balance_method;
 
 /* "none", "laplacian" or "relocation". */
@@ -53,7 +53,7 @@ const char *gp_balance_method_name(gp_balance_method method);
 #define GP_BALANCE_QUALITY_TOL 1e-4
 
 /* The largest step toward the target, as a fraction w of the way; smaller ones follow
- * by 0.05 down to 0.05. The report (Algorithm 3, SPEC §4.4) starts at w = 0.30. Our
+ * by 0.05 down to 0.05. The report (Algorithm 3, docs/method.md §4.4) starts at w = 0.30. Our
  * default starts at the whole way: on the report's fixed-radius case the report's 0.30
  * leaves F_max at 1.71 where the whole way reaches 1.32 (the report: 1.33), and the mean
  * F ends lower on all the reference cases (bench/RESULTS.md). */
@@ -68,7 +68,7 @@ typedef struct gp_quality_stats {
     size_t histogram[GP_QUALITY_BINS];
 } gp_quality_stats;
 
-/* F(p) (SPEC §4.2) for every disk of the triangulation `rt` of disks[0..n-1]: for an
+/* F(p) (docs/method.md §4.2) for every disk of the triangulation `rt` of disks[0..n-1]: for an
  * interior centre p with neighbours p_i, h_i = |p - p_i| - R_p - R_i and
  * F(p) = (max h_i - min h_i) / R_p; NAN elsewhere. A centre is interior when its power
  * cell is bounded and inside the domain (so not on the convex hull): along a wall the

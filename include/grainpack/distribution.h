@@ -33,7 +33,7 @@ typedef struct gp_distribution {
     size_t nbins;    /* GP_DIST_HISTOGRAM: bins sorted by min, not overlapping */
     gp_bin *bins;    /* owned; freed by gp_distribution_free */
     double *cdf;     /* owned; cdf[i] = p_0 + .. + p_i, built by gp_distribution_prepare */
-    int report_same_draw; /* GP_DIST_HISTOGRAM: 0 (SPEC §2) places the radius in its bin
+    int report_same_draw; /* GP_DIST_HISTOGRAM: 0 (docs/method.md §2) places the radius in its bin
                              with an independent draw; 1 reuses the bin-choosing draw, the
                              literal "r' = r" of the report, which honours the bin
                              frequencies but leans to the top of each bin. Only for
@@ -47,7 +47,7 @@ int gp_distribution_prepare(gp_distribution *dist);
 /* Frees what the distribution owns and zeroes it. */
 void gp_distribution_free(gp_distribution *dist);
 
-/* Draws one radius (SPEC §2): a bin by inversion of the cumulative probabilities, then a
+/* Draws one radius (docs/method.md §2): a bin by inversion of the cumulative probabilities, then a
  * position in the bin from an independent second draw. */
 double gp_distribution_sample(const gp_distribution *dist, gp_rng *rng);
 

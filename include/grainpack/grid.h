@@ -1,4 +1,4 @@
-/* grid.h - the bucket grid of SPEC §3.4: square cells of side 2 R_max over the domain,
+/* grid.h - the bucket grid of docs/method.md §3.4: square cells of side 2 R_max over the domain,
  * each holding the disks whose centre it contains, so that every disk a candidate can
  * touch lies in the 3x3 cells around the candidate's centre. */
 #ifndef GRAINPACK_GRID_H

@@ -1,4 +1,4 @@
-/* laguerre.h - polygonal grains (SPEC §5, report §V): the power (Laguerre) cells of the
+/* laguerre.h - polygonal grains (docs/method.md §5, report §V): the power (Laguerre) cells of the
  * disk centres with weights w = R = r + j(r), clipped to the domain so that they tile it,
  * then shrunk to leave the grain-boundary band. */
 #ifndef GRAINPACK_LAGUERRE_H

@@ -1,4 +1,4 @@
-/* pack.h - the advancing-front disk packer (SPEC §3, report §III). */
+/* pack.h - the advancing-front disk packer (docs/method.md §3, report §III). */
 #ifndef GRAINPACK_PACK_H
 #define GRAINPACK_PACK_H
 
@@ -25,7 +25,7 @@ typedef struct gp_pack_params {
     size_t max_disks;            /* fail with GP_ETOOBIG beyond this many disks; 0: no cap */
     uint32_t level_band;         /* segments up to this many levels above the front's level
                                     may take a radius before the front is closed (0: the
-                                    report's rule, SPEC §3.3) */
+                                    report's rule, docs/method.md §3.3) */
 } gp_pack_params;
 
 /* A packing: the disks in the order they were placed, and how the front got there. */
@@ -34,7 +34,7 @@ typedef struct gp_packing {
     size_t count;
     size_t initial_front;    /* disks laid along the boundary (level 0) */
     uint64_t attempts;       /* candidate placements tested for conflicts */
-    uint64_t closures;       /* front closings (SPEC §3.5, last branch) */
+    uint64_t closures;       /* front closings (docs/method.md §3.5, last branch) */
     uint64_t frozen;         /* closings that found no disk to close on and froze the segment */
     uint64_t capped;         /* closings refused by the per-disk safety cap: 0 unless the
                                 front tangled, which the tests check never happens */
@@ -42,7 +42,7 @@ typedef struct gp_packing {
     double fill_area;        /* sum of pi R^2 over the disks */
 } gp_packing;
 
-/* Packs the domain (SPEC §3.5) until the front is empty. On success returns 0 and `out`
+/* Packs the domain (docs/method.md §3.5) until the front is empty. On success returns 0 and `out`
  * owns its disks (free with gp_packing_free). On failure returns GP_ENOMEM, GP_ECANCELED,
  * GP_ETOOBIG (max_disks reached) or GP_EINTERNAL (the front failed to close: a bug), sets
  * err, and leaves `out` zeroed. */

@@ -29,7 +29,7 @@ typedef struct gp_spec_limits {
 /* The widest level band a spec may ask for: beyond a few levels the fill stops being
  * layered and density no longer improves (see bench/). */
 #define GP_SPEC_MAX_LEVEL_BAND 16
-/* Probabilities of a histogram must sum to 1 within this (SPEC §2); never renormalised. */
+/* Probabilities of a histogram must sum to 1 within this (docs/method.md §2); never renormalised. */
 #define GP_SPEC_PROBABILITY_TOL 1e-6
 /* The largest sweep cap a spec may ask balancing for: about an hour of sweeps at the
  * largest packings the disk cap allows (bench/). */

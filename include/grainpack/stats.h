@@ -46,7 +46,7 @@ void gp_pack_stats_free(gp_pack_stats *stats);
 /* Bins of the cell-area histogram, over [min, max] of the areas. */
 #define GP_CELL_AREA_BINS 10
 
-/* What the Laguerre stage made (SPEC §5): the cells, their sizes and neighbours, the
+/* What the Laguerre stage made (docs/method.md §5): the cells, their sizes and neighbours, the
  * grain-boundary band, and how the cells' equivalent radii compare with the target law. */
 typedef struct gp_cell_stats {
     size_t count;

@@ -1,5 +1,5 @@
 /* triangulation.h - the regular (weighted Delaunay) triangulation of the disk centres with
- * weights R^2 (SPEC §4.1, §5), behind a C API. The one C++ file core/triangulation.cpp
+ * weights R^2 (docs/method.md §4.1, §5), behind a C API. The one C++ file core/triangulation.cpp
  * holds it in a CGAL Regular_triangulation_2 with exact predicates; nothing here shows a
  * C++ type, and no C++ exception crosses this API. */
 #ifndef GRAINPACK_TRIANGULATION_H
