@@ -7,7 +7,7 @@
 #define GRAINPACKD_RENDER_H
 
 #include "grainpack/io.h"
-#include "http.h"
+#include "request.h"
 #include "store.h"
 
 /* Picks the format: ?f=NAME wins, else the best match of the Accept header (q-values,

@@ -193,3 +193,11 @@ int gp_router_admit(gp_request *req, const gp_route_entry *rt, size_t uri_bytes,
     }
     return 0;
 }
+
+int gp_router_call(const gp_route_entry *rt, gp_request *req, gp_reply *reply)
+{
+    const char *method = req->method;
+    int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    gp_route_fn fn = is_get ? rt->get : strcmp(method, "POST") == 0 ? rt->post : rt->del;
+    return fn(req, reply);
+}

@@ -3,7 +3,7 @@
 #ifndef GRAINPACKD_ROUTES_H
 #define GRAINPACKD_ROUTES_H
 
-#include "http.h"
+#include "request.h"
 
 /* routes_meta.c: what the service is */
 int gp_route_landing(gp_request *req, gp_reply *reply);

@@ -139,7 +139,7 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
         return GP_ROUTE_DONE;
     gp_job *jobs = malloc((size_t)limit * sizeof *jobs);
     if (!jobs) {
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory");
+        gp_problem_out_of_memory(reply);
         return GP_ROUTE_DONE;
     }
     size_t n = 0;

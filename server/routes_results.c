@@ -48,9 +48,14 @@ static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp
     int rc = gp_render_load(db, req->id, req->owner, spec, result);
     if (rc == GP_SRV_ENOTFOUND) /* deleted between the two reads */
         return without_result(req, db, reply);
+    if (rc == GP_ENOMEM) {
+        gp_problem_out_of_memory(reply);
+        return 1;
+    }
     if (rc) {
         gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path,
-                   "the stored result of job %s could not be read (%d)", req->id, rc);
+                   "the stored result of job %s could not be read: %s", req->id,
+                   gp_srv_strerror(rc));
         return 1;
     }
     return 0;
@@ -70,11 +75,14 @@ int gp_route_results(gp_request *req, gp_reply *reply)
         return GP_ROUTE_DONE;
     char *body;
     size_t len;
-    if (gp_render_format(&spec, &result, format, &body, &len) == 0)
+    int rc = gp_render_format(&spec, &result, format, &body, &len);
+    if (rc == 0)
         gp_reply_take(reply, 200, gp_format_media_type(format), body, len);
+    else if (rc == GP_ENOMEM)
+        gp_problem_out_of_memory(reply);
     else
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "rendering %s failed",
-                   gp_format_name(format));
+        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "rendering %s failed: %s",
+                   gp_format_name(format), gp_strerror(rc));
     gp_result_free(&result);
     gp_spec_free(&spec);
     return GP_ROUTE_DONE;
