@@ -16,6 +16,11 @@ typedef struct gp_reply {
     int retry_after;          /* Retry-After seconds (429, 503), 0 for none */
     char www_authenticate[96]; /* WWW-Authenticate header (401), "" for none */
     int close;                /* close the connection after this answer */
+    const char *vary;         /* Vary header (static), NULL for none: the answer depends on it */
+    const char *cache_control; /* Cache-Control header (static), NULL for none */
+    const char *etag;         /* ETag header (static, quoted), NULL for none */
+    const char *csp;          /* Content-Security-Policy (static) of a page, NULL for none;
+                                 with it, the page's other security headers are sent too */
 } gp_reply;
 
 /* Serialises `value` (reference stolen) as the body with the given status and media type.
