@@ -11,7 +11,7 @@
 /* The page loads nothing from elsewhere and runs no inline script or style: everything
  * comes from this origin, and pictures of results are blob: URLs made from fetched SVG. */
 #define PAGE_CSP                                                                            \
-    "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' blob: data:; " \
+    "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' blob:; " \
     "connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"
 /* Revalidated at every use (a 304 with the ETag costs a few bytes): a daemon upgraded in
  * place never serves a page that no longer matches its API from a browser's cache. */

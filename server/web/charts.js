@@ -60,7 +60,7 @@ function frame({ title, desc, xLabel, yLabel, x0, x1, y1, legend = [] }) {
     const text = svgEl('text', { x: lx, y: 14, 'text-anchor': 'end' }, item.label);
     // about 6 px a character at the charts' 11 px
     lx -= 6.2 * item.label.length + 4;
-    axes.append(svgEl('rect', { class: item.cls, x: lx - 11, y: 5, width: 11, height: 11 }), text);
+    axes.append(svgEl('rect', { class: `legend ${item.cls}`, x: lx - 11, y: 5, width: 11, height: 11 }), text);
     lx -= 24;
   }
   svg.append(axes);

@@ -209,6 +209,7 @@ export class DesignView {
     let target = null;
     if (typeof pointer === 'string') {
       for (const node of this.form.querySelectorAll('[data-pointer]')) {
+        if (node.closest('[hidden]')) continue; // another branch of a law shares the pointer
         const p = node.dataset.pointer;
         const matches = pointer === p || pointer.startsWith(`${p}/`);
         if (matches && (!target || p.length > target.dataset.pointer.length)) target = node;

@@ -97,6 +97,10 @@ export class JobView {
         wait = POLL_WAIT;
       } catch (err) {
         if (err.name === 'AbortError' || signal.aborted) return;
+        if (err.status === 404) {
+          this.status.textContent = 'not found';
+          this.progress.hidden = true;
+        }
         this.error.replaceChildren(el('p', { class: 'error-summary' }, err.status === 404
           ? `There is no job ${id} that you may see: it was deleted, or it belongs to someone else.`
           : describe(err)));
