@@ -6,7 +6,7 @@
 import { fmtNum, svgEl, uid } from './dom.js';
 
 const W = 480;
-const H = 250;
+const H = 220;
 const M = { left: 56, right: 14, top: 30, bottom: 44 };
 
 // About n round tick values covering [lo, hi].

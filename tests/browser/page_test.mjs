@@ -146,6 +146,11 @@ async function designIron(page) {
   check(await page.locator('figure.plot svg.chart rect.target:not(.legend)').count() === 12, 'the target histogram is not drawn with 12 bars');
   await page.getByLabel('Law', { exact: true }).selectOption('inverse');
   await page.locator('[data-pointer="/inputs/joint/k"] input:visible').fill('2');
+  // the stages: each a switch and its options, made from the process description
+  await page.getByLabel('Balancing').check();
+  await page.locator('select[name=method]').selectOption('relocation');
+  await page.getByLabel('Laguerre cells').check();
+  await page.locator('select[name=shrink]').selectOption('offset');
 }
 
 async function invalidBin(page) {
@@ -181,9 +186,20 @@ async function result(page, base) {
   check(await achieved.locator('rect.achieved:not(.legend)').count() === 12, 'the achieved histogram has not 12 bars');
   check(await achieved.locator('path.errorbar').count() >= 10, 'the achieved histogram has no error bars');
   const figures = await page.locator('.stats dl.figures').first().textContent();
-  check(/grains\s*990/.test(figures.replace(/,/g, '')) || /grains/.test(figures), `figures: ${figures}`);
-  await shot(page, 'result');
+  const stats = await (await fetch(`${base}/jobs/${id}/statistics`)).json();
+  check(figures.replace(/,/g, '').includes(`grains${stats.count}`), `figures: ${figures}`);
+  // F after balancing and the cells, beside the picture coloured by F
+  check(await page.locator('.stats svg.chart rect.after:not(.legend)').count() >= 10, 'no histogram of F and neighbours');
+  check((await page.locator('.stats').textContent()).includes('grain-boundary band'), 'no cell statistics');
+  check(await page.getByLabel('Colour by').inputValue() === 'quality', 'a balanced job is not coloured by F first');
   await shot(page, 'result-screen', false);
+  const byF = await page.locator('.viewer img').getAttribute('src');
+  await page.getByLabel('Colour by').selectOption('radius');
+  await page.waitForFunction((before) => {
+    const img = document.querySelector('.viewer img');
+    return img.src !== before && img.complete && img.naturalWidth > 0;
+  }, byF, { timeout: STEP });
+  await shot(page, 'result');
   // the picture from the keyboard: + zooms, 0 shows it whole
   const viewer = page.locator('.viewer');
   await viewer.focus();
@@ -302,6 +318,7 @@ async function openService(dir) {
   const ironInputs = JSON.parse(fs.readFileSync(path.join(config.examples, 'iron.json'))).inputs;
   const disks = await shownDisks(page, await expectedDisks(config.open, ironInputs));
   await shot(page, 'design');
+  await page.locator('.summary').scrollIntoViewIfNeeded();
   await shot(page, 'design-screen', false);
   await invalidBin(page);
   await page.getByRole('button', { name: 'Submit the job' }).click();
