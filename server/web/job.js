@@ -46,7 +46,7 @@ export class JobView {
 
   // Shows job `id` (or the hint when there is none), watching it until it is finished.
   open(id) {
-    if (id === this.id && this.controller) return;
+    if (id && id === this.id) return; // shown already, and watched while it runs
     this.close();
     this.id = id;
     if (!id) {
@@ -58,7 +58,8 @@ export class JobView {
     this.status = el('span', { class: 'badge' }, '…');
     this.progress = el('progress', { max: 100, value: 0, 'aria-label': 'progress of the job' });
     this.percent = el('span', { class: 'percent' });
-    this.message = el('p', { class: 'stage', role: 'status', 'aria-live': 'polite' });
+    // not a live region: it changes every second; changes of status are announced instead
+    this.message = el('p', { class: 'stage' });
     this.times = el('dl', { class: 'times' });
     this.actions = el('div', { class: 'actions' });
     this.error = el('div', { role: 'alert' });
