@@ -24,6 +24,9 @@ const CHROMIUM_FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disabl
 const PAGE_BUDGET = 200 * 1024;
 // How long a step may take before the scenario fails (ms): a bound on a broken run.
 const STEP = 30000;
+// The same for a job to run, or a picture to be drawn: much longer under AddressSanitizer
+// on a loaded machine (the iron job that balances and builds cells took over 30 s there).
+const JOB = 300000;
 const DESKTOP = { width: 1280, height: 800 };
 const NARROW = { width: 390, height: 844 };
 
@@ -176,12 +179,12 @@ async function invalidBin(page) {
 async function result(page, base) {
   await page.waitForURL(/#job\//, { timeout: STEP });
   const id = decodeURIComponent(new URL(page.url()).hash.slice('#job/'.length));
-  await page.locator('#view-job .badge.successful').waitFor({ timeout: STEP });
+  await page.locator('#view-job .badge.successful').waitFor({ timeout: JOB });
   check(await page.locator('progress').getAttribute('value') === '100', 'progress is not 100 at the end');
   await page.waitForFunction(() => {
     const img = document.querySelector('.viewer img');
     return img && img.complete && img.naturalWidth > 0;
-  }, null, { timeout: STEP });
+  }, null, { timeout: JOB });
   const achieved = page.locator('.stats svg.chart').first();
   check(await achieved.locator('rect.achieved:not(.legend)').count() === 12, 'the achieved histogram has not 12 bars');
   check(await achieved.locator('path.errorbar').count() >= 10, 'the achieved histogram has no error bars');
@@ -198,7 +201,7 @@ async function result(page, base) {
   await page.waitForFunction((before) => {
     const img = document.querySelector('.viewer img');
     return img.src !== before && img.complete && img.naturalWidth > 0;
-  }, byF, { timeout: STEP });
+  }, byF, { timeout: JOB });
   await shot(page, 'result');
   // the picture from the keyboard: + zooms, 0 shows it whole
   const viewer = page.locator('.viewer');
@@ -236,13 +239,13 @@ async function longJob(page) {
   await page.getByRole('button', { name: 'Submit the job' }).click();
   await page.waitForURL(/#job\//, { timeout: STEP });
   const id = decodeURIComponent(new URL(page.url()).hash.slice('#job/'.length));
-  await page.locator('#view-job .badge.running').waitFor({ timeout: STEP });
-  await page.waitForFunction(() => Number(document.querySelector('progress').value) > 0, null, { timeout: STEP });
+  await page.locator('#view-job .badge.running').waitFor({ timeout: JOB });
+  await page.waitForFunction(() => Number(document.querySelector('progress').value) > 0, null, { timeout: JOB });
   const stage = await page.locator('.stage').textContent();
   check(/^running: \w+ \d+%$/.test(stage), `the running job's stage line: ${stage}`);
   await shot(page, 'running', false);
   await page.getByRole('button', { name: 'Dismiss this job' }).click();
-  await page.locator('#view-job .badge.dismissed').waitFor({ timeout: STEP });
+  await page.locator('#view-job .badge.dismissed').waitFor({ timeout: JOB });
   return id;
 }
 
@@ -286,7 +289,7 @@ async function keyboard(page) {
   metrics.tab_stops_to_submit = seen.length;
   await page.keyboard.press('Enter');
   await page.waitForURL(/#job\//, { timeout: STEP });
-  await page.locator('#view-job .badge.successful').waitFor({ timeout: STEP });
+  await page.locator('#view-job .badge.successful').waitFor({ timeout: JOB });
 }
 
 async function narrow(page) {
@@ -350,8 +353,8 @@ async function keysService(dirA, dirB) {
   await pageA.getByRole('button', { name: 'Submit the job' }).click();
   await pageA.waitForURL(/#job\//, { timeout: STEP });
   const id = decodeURIComponent(new URL(pageA.url()).hash.slice('#job/'.length));
-  await pageA.locator('#view-job .badge.successful').waitFor({ timeout: STEP });
-  await pageA.waitForFunction(() => document.querySelector('.viewer img')?.naturalWidth > 0, null, { timeout: STEP });
+  await pageA.locator('#view-job .badge.successful').waitFor({ timeout: JOB });
+  await pageA.waitForFunction(() => document.querySelector('.viewer img')?.naturalWidth > 0, null, { timeout: JOB });
   const [download] = await Promise.all([pageA.waitForEvent('download', { timeout: STEP }),
     pageA.getByRole('link', { name: 'CSV', exact: true }).click()]);
   const csv = path.join(config.out, 'alice.csv');
