@@ -158,6 +158,17 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
     }
     if (reply->close)
         MHD_add_response_header(resp, "Connection", "close");
+    if (reply->vary)
+        MHD_add_response_header(resp, "Vary", reply->vary);
+    if (reply->cache_control)
+        MHD_add_response_header(resp, "Cache-Control", reply->cache_control);
+    if (reply->etag)
+        MHD_add_response_header(resp, "ETag", reply->etag);
+    if (reply->csp) { /* the web page's files: no sniffing, no framing, no referrer */
+        MHD_add_response_header(resp, "Content-Security-Policy", reply->csp);
+        MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
+        MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
+    }
     add_cors(svc, conn, resp, st->route, preflight);
     enum MHD_Result rc = MHD_queue_response(conn, reply->status, resp);
     MHD_destroy_response(resp);

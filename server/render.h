@@ -15,6 +15,10 @@
  * unknown f, 406 when Accept allows none). */
 int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *reply);
 
+/* The q that an Accept header gives media type mt: that of its most specific matching
+ * range (exact, type/any, any/any), 0 when none matches. */
+double gp_accept_quality(const char *accept, const char *mt);
+
 /* Rebuilds the spec and result of a successful job of `owner` (NULL: any owner; see
  * store.h). On success returns 0 and the caller frees both (gp_spec_free,
  * gp_result_free); else GP_SRV_ENOTFOUND, GP_SRV_EDB, GP_ENOMEM or the engine's code,

@@ -18,6 +18,11 @@ typedef struct gp_reply {
     int close;                /* close the connection after this answer */
     int persistent;           /* body is a static text, never freed (the out-of-memory
                                  answer: gp_problem_out_of_memory) */
+    const char *vary;         /* Vary header (static), NULL for none: the answer depends on it */
+    const char *cache_control; /* Cache-Control header (static), NULL for none */
+    const char *etag;         /* ETag header (static, quoted), NULL for none */
+    const char *csp;          /* Content-Security-Policy (static) of a page, NULL for none;
+                                 with it, the page's other security headers are sent too */
 } gp_reply;
 
 /* Serialises `value` (reference stolen) as the body with the given status and media type.

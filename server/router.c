@@ -17,6 +17,7 @@ static const gp_route_entry routes[] = {
     {"/processes", GP_ACCESS_PUBLIC, gp_route_processes, NULL, NULL},
     {"/processes/{}", GP_ACCESS_PUBLIC, gp_route_process, NULL, NULL},
     {"/processes/{}/execution", GP_ACCESS_KEY, NULL, gp_route_execute, NULL},
+    {"/processes/{}/validation", GP_ACCESS_KEY, NULL, gp_route_validate, NULL},
     {"/jobs", GP_ACCESS_KEY, gp_route_jobs, NULL, NULL},
     {"/jobs/{}", GP_ACCESS_KEY, gp_route_job, NULL, gp_route_dismiss},
     {"/jobs/{}/results", GP_ACCESS_KEY, gp_route_results, NULL, NULL},
@@ -24,6 +25,7 @@ static const gp_route_entry routes[] = {
     {"/health", GP_ACCESS_PUBLIC, gp_route_health, NULL, NULL},
     {"/metrics", GP_ACCESS_ADMIN, gp_route_metrics, NULL, NULL},
     {"/openapi.yaml", GP_ACCESS_PUBLIC, gp_route_openapi, NULL, NULL},
+    {"/ui/{}", GP_ACCESS_PUBLIC, gp_route_web_file, NULL, NULL},
 };
 #define NROUTES (sizeof routes / sizeof routes[0])
 

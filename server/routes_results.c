@@ -61,10 +61,28 @@ static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp
     return 0;
 }
 
+/* Reads ?color=radius|quality, what the picture is coloured by (the spec's choice when
+ * absent). Returns 0 with *color set, or -1 with a 400 in reply. */
+static int picture_color(const gp_request *req, int *color, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, "color");
+    *color = -1;
+    if (!text)
+        return 0;
+    if (strcmp(text, "radius") == 0 || strcmp(text, "quality") == 0) {
+        *color = strcmp(text, "radius") == 0 ? GP_PICTURE_COLOR_RADIUS : GP_PICTURE_COLOR_QUALITY;
+        return 0;
+    }
+    gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+               "color must be radius or quality (F, for a job that balanced), got '%.40s'", text);
+    return -1;
+}
+
 int gp_route_results(gp_request *req, gp_reply *reply)
 {
     gp_format format;
-    if (gp_render_choose_format(req, &format, reply))
+    int color;
+    if (gp_render_choose_format(req, &format, reply) || picture_color(req, &color, reply))
         return GP_ROUTE_DONE;
     gp_spec spec;
     gp_result result;
@@ -73,6 +91,16 @@ int gp_route_results(gp_request *req, gp_reply *reply)
     gp_store_release(req->svc->store, db);
     if (missing)
         return GP_ROUTE_DONE;
+    if (color == GP_PICTURE_COLOR_QUALITY && !result.has_balance) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "color=quality colours the grains by F, which only a job that balances has; "
+                   "job %s has no balance stage (color=radius)", req->id);
+        gp_result_free(&result);
+        gp_spec_free(&spec);
+        return GP_ROUTE_DONE;
+    }
+    if (color >= 0)
+        spec.picture_color = (gp_picture_color)color;
     char *body;
     size_t len;
     int rc = gp_render_format(&spec, &result, format, &body, &len);
