@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "grainpack/grid.h"
+#include "grid.h"
 
 /* Steps tried toward the target, as fractions w of the way: from the largest allowed
  * (gp_balance_params.max_step) down by 0.05 to 0.05, as report Algorithm 3 does from

@@ -21,7 +21,7 @@
 #include <stdint.h>
 
 #include "grainpack/disk.h"
-#include "grainpack/grid.h"
+#include "grid.h"
 
 #define FRONT_NONE (-1)
 

@@ -1,5 +1,5 @@
 /* grid.c - bucket grid for neighbour queries (docs/method.md §3.4). */
-#include "grainpack/grid.h"
+#include "grid.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "front.h"
-#include "grainpack/grid.h"
+#include "grid.h"
 
 /* Fraction of the domain a packing is expected to fill: used for the capacity guess and
  * to turn the filled area into a progress fraction. */

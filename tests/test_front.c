@@ -4,7 +4,7 @@
 
 #include "check.h"
 #include "front.h"
-#include "grainpack/grid.h"
+#include "grid.h"
 
 typedef struct fixture {
     gp_domain dom;

@@ -5,9 +5,9 @@
 #include "grainpack/disk.h"
 #include "grainpack/domain.h"
 #include "grainpack/error.h"
-#include "grainpack/grid.h"
 #include "grainpack/joint.h"
 #include "grainpack/rng.h"
+#include "grid.h"
 
 static void test_placed_disk_touches_both_on_the_left(void)
 {

@@ -1,8 +1,8 @@
-/* grid.h - the bucket grid of docs/method.md §3.4: square cells of side 2 R_max over the domain,
- * each holding the disks whose centre it contains, so that every disk a candidate can
- * touch lies in the 3x3 cells around the candidate's centre. */
-#ifndef GRAINPACK_GRID_H
-#define GRAINPACK_GRID_H
+/* grid.h - the bucket grid of docs/method.md §3.4 (internal to core/): square cells of
+ * side 2 R_max over the domain, each holding the disks whose centre it contains, so that
+ * every disk a candidate can touch lies in the 3x3 cells around the candidate's centre. */
+#ifndef GRAINPACK_CORE_GRID_H
+#define GRAINPACK_CORE_GRID_H
 
 #include <stddef.h>
 #include <stdint.h>
