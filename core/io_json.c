@@ -2,6 +2,7 @@
 #include <math.h>
 
 #include "grainpack/io.h"
+#include "json_values.h"
 
 /* json_object_set_new that remembers a failure instead of returning it at every call. */
 static void put(json_t *obj, const char *key, json_t *value, int *failed)

@@ -1,8 +1,6 @@
 /* spec_json.c - a parsed job spec written back as JSON, with every default made
  * explicit: what the validator understood, for a client to show or to submit as it is. */
-#include <jansson.h>
-
-#include "grainpack/spec.h"
+#include "json_values.h"
 
 /* json_object_set_new that remembers a failure instead of returning it at every call. */
 static void put(json_t *obj, const char *key, json_t *value, int *failed)

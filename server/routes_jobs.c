@@ -8,6 +8,7 @@
 
 #include "grainpack/spec.h"
 #include "jobinfo.h"
+#include "json_values.h"
 #include "log.h"
 #include "problem.h"
 #include "routes.h"

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "grainpack/io.h"
+#include "json_values.h"
 #include "problem.h"
 #include "render.h"
 #include "routes.h"

@@ -5,6 +5,7 @@
 
 #include "check.h"
 #include "grainpack/spec.h"
+#include "json_values.h"
 
 #define IRON_BINS                                                                            \
     "[{\"min\":2.0,\"max\":2.5,\"p\":0.15801024},{\"min\":2.5,\"max\":3.0,\"p\":0.20994879},"  \

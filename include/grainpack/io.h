@@ -4,7 +4,6 @@
 #ifndef GRAINPACK_IO_H
 #define GRAINPACK_IO_H
 
-#include <jansson.h>
 #include <stdio.h>
 
 #include "grainpack/pipeline.h"
@@ -29,12 +28,6 @@ const char *gp_format_name(gp_format format);
 size_t gp_format_count(void);
 /* The media type to serve the format with ("text/csv; charset=utf-8", ...). */
 const char *gp_format_media_type(gp_format format);
-
-/* The statistics of a result as a new JSON object (caller owns the reference; NULL when
- * out of memory): count, densities, radii, the per-bin target-versus-achieved table with
- * chi-square, and how the front went. Timings are not included (they are not
- * reproducible); the caller adds them where it wants them. */
-json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result);
 
 /* Each writer returns 0, or GP_EIO when the stream reports an error (GP_ENOMEM when a
  * JSON value cannot be built). Numbers are written with 17 significant digits where they
