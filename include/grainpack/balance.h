@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/api.h"
 #include "grainpack/disk.h"
 #include "grainpack/domain.h"
 #include "grainpack/error.h"
@@ -24,7 +25,7 @@ typedef enum gp_balance_method {
 } gp_balance_method;
 
 /* "none", "laplacian" or "relocation". */
-const char *gp_balance_method_name(gp_balance_method method);
+GP_API const char *gp_balance_method_name(gp_balance_method method);
 
 /* The report shows F as a histogram of ten bins over [F_min, F_max]. */
 #define GP_QUALITY_BINS 10
@@ -76,8 +77,8 @@ typedef struct gp_quality_stats {
  * one has "neighbours" far along the wall whose gaps say nothing of the free space around
  * it. These centres (the layer along the walls) are also the ones balancing leaves in
  * place. F may be NULL when only the statistics are wanted. Returns 0 or GP_ENOMEM. */
-int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, gp_error *err);
+GP_API int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n,
+                      double *F, gp_quality_stats *stats, gp_error *err);
 
 typedef struct gp_balance_params {
     gp_balance_method method;
@@ -94,7 +95,7 @@ typedef enum gp_balance_stop {
 } gp_balance_stop;
 
 /* "converged", "stalled" or "max_iterations". */
-const char *gp_balance_stop_name(gp_balance_stop stop);
+GP_API const char *gp_balance_stop_name(gp_balance_stop stop);
 
 typedef struct gp_balance_result {
     gp_balance_method method;
@@ -126,11 +127,11 @@ typedef struct gp_balance_result {
  * On failure returns GP_ENOMEM, GP_ECANCELED, GP_ETOOBIG (bucket grid too large) or a
  * triangulation error (GP_EGEOM, GP_EINTERNAL), fills err, zeroes `out`; the disks are
  * then valid but partly balanced, and rt must only be freed. */
-int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
-               const gp_balance_params *params, const gp_progress *progress,
-               gp_balance_result *out, gp_error *err);
+GP_API int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
+                      const gp_balance_params *params, const gp_progress *progress,
+                      gp_balance_result *out, gp_error *err);
 
-void gp_balance_result_free(gp_balance_result *result);
+GP_API void gp_balance_result_free(gp_balance_result *result);
 
 #ifdef __cplusplus
 }

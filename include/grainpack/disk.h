@@ -2,6 +2,8 @@
 #ifndef GRAINPACK_DISK_H
 #define GRAINPACK_DISK_H
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -40,7 +42,7 @@ static inline double gp_orient2d(double ax, double ay, double bx, double by, dou
 /* The centre of a disk of radius R tangent to disks (c1, R1) and (c2, R2), on the left of
  * the oriented segment c1 -> c2 (docs/method.md §3.1). Returns 1 and sets (*x, *y) when such a disk
  * exists (|a - b| <= d <= a + b with a = R1 + R, b = R2 + R), 0 otherwise. */
-int gp_place_tangent(const gp_disk *c1, const gp_disk *c2, double R, double *x, double *y);
+GP_API int gp_place_tangent(const gp_disk *c1, const gp_disk *c2, double R, double *x, double *y);
 
 #ifdef __cplusplus
 }

@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 
+#include "grainpack/api.h"
 #include "grainpack/joint.h"
 #include "grainpack/rng.h"
 
@@ -42,29 +43,29 @@ typedef struct gp_distribution {
 
 /* Builds the sampling table of a histogram (no-op for other kinds). Call once after the
  * fields are set and validated; returns 0 or GP_ENOMEM. */
-int gp_distribution_prepare(gp_distribution *dist);
+GP_API int gp_distribution_prepare(gp_distribution *dist);
 
 /* Frees what the distribution owns and zeroes it. */
-void gp_distribution_free(gp_distribution *dist);
+GP_API void gp_distribution_free(gp_distribution *dist);
 
 /* Draws one radius (docs/method.md §2): a bin by inversion of the cumulative probabilities, then a
  * position in the bin from an independent second draw. */
-double gp_distribution_sample(const gp_distribution *dist, gp_rng *rng);
+GP_API double gp_distribution_sample(const gp_distribution *dist, gp_rng *rng);
 
 /* The support [*r_min, *r_max]: the smallest and largest radius that can be drawn
  * (bins of probability zero are not part of it). */
-void gp_distribution_support(const gp_distribution *dist, double *r_min, double *r_max);
+GP_API void gp_distribution_support(const gp_distribution *dist, double *r_min, double *r_max);
 
 /* The expected value of (r + j(r))^2: the mean packing-disk area divided by pi. */
-double gp_distribution_mean_packing_r2(const gp_distribution *dist, const gp_joint *joint);
+GP_API double gp_distribution_mean_packing_r2(const gp_distribution *dist, const gp_joint *joint);
 
 /* The bins achieved radii are reported against: the histogram's own, ten equal bins for
  * the uniform law, one degenerate bin for a constant radius. Writes at most `cap` bins to
  * `out` and returns how many there are. */
-size_t gp_distribution_report_bins(const gp_distribution *dist, gp_bin *out, size_t cap);
+GP_API size_t gp_distribution_report_bins(const gp_distribution *dist, gp_bin *out, size_t cap);
 
 /* "constant", "uniform" or "histogram". */
-const char *gp_dist_kind_name(gp_dist_kind kind);
+GP_API const char *gp_dist_kind_name(gp_dist_kind kind);
 
 #ifdef __cplusplus
 }

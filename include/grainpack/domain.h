@@ -2,6 +2,8 @@
 #ifndef GRAINPACK_DOMAIN_H
 #define GRAINPACK_DOMAIN_H
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -14,9 +16,9 @@ typedef struct gp_domain {
 #define GP_DOMAIN_CORNERS 4
 
 /* Corner i (0 <= i < GP_DOMAIN_CORNERS), counter-clockwise starting at the origin. */
-void gp_domain_corner(const gp_domain *domain, int i, double *x, double *y);
+GP_API void gp_domain_corner(const gp_domain *domain, int i, double *x, double *y);
 
-double gp_domain_area(const gp_domain *domain);
+GP_API double gp_domain_area(const gp_domain *domain);
 
 /* Whether the disk (x, y, R) lies inside the domain, allowing it to stick out by at most
  * `slack` (a non-negative length; the packer uses R * GP_CONTACT_RTOL, see disk.h).

@@ -3,6 +3,8 @@
 #ifndef GRAINPACK_ERROR_H
 #define GRAINPACK_ERROR_H
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -31,18 +33,18 @@ typedef struct gp_error {
 } gp_error;
 
 /* Clears err (no-op on NULL). */
-void gp_error_clear(gp_error *err);
+GP_API void gp_error_clear(gp_error *err);
 
 /* Records code, pointer (may be NULL) and a printf-style message in err (no-op on NULL);
  * returns code so that a caller can write `return gp_error_set(err, GP_EINVAL, ...)`. */
-int gp_error_set(gp_error *err, int code, const char *pointer, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
+GP_API int gp_error_set(gp_error *err, int code, const char *pointer, const char *fmt, ...)
+       #if defined(__GNUC__)
+           __attribute__((format(printf, 4, 5)))
+       #endif
+           ;
 
 /* A short constant English name for a code ("invalid input", ...). */
-const char *gp_strerror(int code);
+GP_API const char *gp_strerror(int code);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 
+#include "grainpack/api.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
 
@@ -21,22 +22,23 @@ typedef enum gp_format {
 } gp_format;
 
 /* Maps "json", "csv", "svg" or "vtk" to a format; returns 0 or GP_EINVAL. */
-int gp_format_parse(const char *name, gp_format *out);
-const char *gp_format_name(gp_format format);
+GP_API int gp_format_parse(const char *name, gp_format *out);
+GP_API const char *gp_format_name(gp_format format);
 /* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,
  * so a caller can list them without knowing their names (the service does). */
-size_t gp_format_count(void);
+GP_API size_t gp_format_count(void);
 /* The media type to serve the format with ("text/csv; charset=utf-8", ...). */
-const char *gp_format_media_type(gp_format format);
+GP_API const char *gp_format_media_type(gp_format format);
 
 /* Each writer returns 0, or GP_EIO when the stream reports an error (GP_ENOMEM when a
  * JSON value cannot be built). Numbers are written with 17 significant digits where they
  * describe geometry, so a reader gets the exact doubles back. */
-int gp_write_csv(FILE *out, const gp_result *result);
-int gp_write_json(FILE *out, const gp_spec *spec, const gp_result *result);
-int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result);
-int gp_write_vtk(FILE *out, const gp_spec *spec, const gp_result *result);
-int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result);
+GP_API int gp_write_csv(FILE *out, const gp_result *result);
+GP_API int gp_write_json(FILE *out, const gp_spec *spec, const gp_result *result);
+GP_API int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result);
+GP_API int gp_write_vtk(FILE *out, const gp_spec *spec, const gp_result *result);
+GP_API int gp_write_result(FILE *out, gp_format format, const gp_spec *spec,
+                           const gp_result *result);
 
 #ifdef __cplusplus
 }

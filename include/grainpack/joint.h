@@ -2,6 +2,8 @@
 #ifndef GRAINPACK_JOINT_H
 #define GRAINPACK_JOINT_H
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -21,18 +23,18 @@ typedef struct gp_joint {
 } gp_joint;
 
 /* j(r) for a grain of radius r > 0. */
-double gp_joint_thickness(const gp_joint *joint, double r);
+GP_API double gp_joint_thickness(const gp_joint *joint, double r);
 
 /* The packing radius R = r + j(r). */
-double gp_joint_packing_radius(const gp_joint *joint, double r);
+GP_API double gp_joint_packing_radius(const gp_joint *joint, double r);
 
 /* The range [*R_min, *R_max] of the packing radius over r in [r_min, r_max].
  * Every law here is convex or monotone in r, which the function relies on. */
-void gp_joint_packing_range(const gp_joint *joint, double r_min, double r_max, double *R_min,
-                            double *R_max);
+GP_API void gp_joint_packing_range(const gp_joint *joint, double r_min, double r_max, double *R_min,
+                                   double *R_max);
 
 /* "none", "constant", "inverse" or "power". */
-const char *gp_joint_law_name(gp_joint_law law);
+GP_API const char *gp_joint_law_name(gp_joint_law law);
 
 #ifdef __cplusplus
 }

@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/api.h"
 #include "grainpack/disk.h"
 #include "grainpack/domain.h"
 #include "grainpack/error.h"
@@ -24,7 +25,7 @@ typedef enum gp_shrink {
 } gp_shrink;
 
 /* "none", "homothetic" or "offset". */
-const char *gp_shrink_name(gp_shrink shrink);
+GP_API const char *gp_shrink_name(gp_shrink shrink);
 
 typedef struct gp_laguerre_params {
     gp_shrink shrink;
@@ -63,15 +64,15 @@ typedef struct gp_cells {
  * On success returns 0 and `out` owns its arrays (free with gp_cells_free). Fails with
  * GP_ENOMEM, GP_ECANCELED, or GP_EGEOM when a centre lies outside its own cell (a disk
  * outside the domain, or overlapping disks); err says which; `out` is zeroed. */
-int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
-                const gp_laguerre_params *params, const gp_progress *progress,
-                gp_cells *out, gp_error *err);
+GP_API int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
+                       const gp_laguerre_params *params, const gp_progress *progress,
+                       gp_cells *out, gp_error *err);
 
-void gp_cells_free(gp_cells *cells);
+GP_API void gp_cells_free(gp_cells *cells);
 
 /* The area of a polygon given as n interleaved x, y vertices (positive when
  * counter-clockwise). */
-double gp_polygon_area(const double *xy, size_t n);
+GP_API double gp_polygon_area(const double *xy, size_t n);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -38,37 +40,37 @@ typedef struct gp_out {
 /* Sets `o` up with a buffer of `capacity` bytes (0: GP_OUT_DEFAULT_CAPACITY) in front of
  * `sink` (NULL: memory mode). Returns 0 or GP_ENOMEM (then `o` is zeroed). Free with
  * gp_out_free. */
-int gp_out_init(gp_out *o, size_t capacity, gp_out_sink sink, void *ctx);
+GP_API int gp_out_init(gp_out *o, size_t capacity, gp_out_sink sink, void *ctx);
 
 /* A sink writing to `file` (borrowed): GP_EIO when fwrite falls short. */
-int gp_out_init_file(gp_out *o, FILE *file);
+GP_API int gp_out_init_file(gp_out *o, FILE *file);
 
-void gp_out_write(gp_out *o, const void *data, size_t len);
-void gp_out_puts(gp_out *o, const char *text);
-void gp_out_char(gp_out *o, char c);
+GP_API void gp_out_write(gp_out *o, const void *data, size_t len);
+GP_API void gp_out_puts(gp_out *o, const char *text);
+GP_API void gp_out_char(gp_out *o, char c);
 /* The shortest decimal that reads back (strtod) to exactly x: 0.06, 1e-7, 123456, 1.5e+300;
  * "NaN", "Infinity" and "-Infinity" for the non-finite (writers that cannot show them
  * test first). */
-void gp_out_double(gp_out *o, double x);
+GP_API void gp_out_double(gp_out *o, double x);
 /* x rounded to `decimals` digits after the point, trailing zeros (and a bare point)
  * dropped: for picture coordinates, where a screen shows no more. */
-void gp_out_fixed(gp_out *o, double x, int decimals);
-void gp_out_int(gp_out *o, int64_t v);
-void gp_out_uint(gp_out *o, uint64_t v);
+GP_API void gp_out_fixed(gp_out *o, double x, int decimals);
+GP_API void gp_out_int(gp_out *o, int64_t v);
+GP_API void gp_out_uint(gp_out *o, uint64_t v);
 
 /* Hands what is buffered to the sink (no-op in memory mode). Returns o->err. */
-int gp_out_flush(gp_out *o);
+GP_API int gp_out_flush(gp_out *o);
 
 /* Memory mode: moves up to `max` bytes from the front of the buffer to dst and returns
  * how many. */
-size_t gp_out_take(gp_out *o, char *dst, size_t max);
+GP_API size_t gp_out_take(gp_out *o, char *dst, size_t max);
 
 /* Frees the buffer and zeroes `o` (without flushing). */
-void gp_out_free(gp_out *o);
+GP_API void gp_out_free(gp_out *o);
 
 /* The text gp_out_double writes, NUL-terminated, into buf (at least GP_FMT_DOUBLE_MAX +
  * 1 bytes); returns its length. */
-size_t gp_fmt_double(char *buf, double x);
+GP_API size_t gp_fmt_double(char *buf, double x);
 
 #ifdef __cplusplus
 }

@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/api.h"
 #include "grainpack/disk.h"
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
@@ -46,11 +47,11 @@ typedef struct gp_packing {
  * owns its disks (free with gp_packing_free). On failure returns GP_ENOMEM, GP_ECANCELED,
  * GP_ETOOBIG (max_disks reached) or GP_EINTERNAL (the front failed to close: a bug), sets
  * err, and leaves `out` zeroed. */
-int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
-            gp_error *err);
+GP_API int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
+                   gp_error *err);
 
 /* Frees the disks of a packing and zeroes it. */
-void gp_packing_free(gp_packing *packing);
+GP_API void gp_packing_free(gp_packing *packing);
 
 #ifdef __cplusplus
 }

@@ -4,6 +4,7 @@
 #ifndef GRAINPACK_PIPELINE_H
 #define GRAINPACK_PIPELINE_H
 
+#include "grainpack/api.h"
 #include "grainpack/balance.h"
 #include "grainpack/error.h"
 #include "grainpack/laguerre.h"
@@ -39,8 +40,8 @@ typedef struct gp_result {
 /* Runs every stage the spec asks for. `max_disks` caps the packing (0: none). On success
  * returns 0 and `result` owns everything in it (free with gp_result_free); on failure
  * returns the failing stage's code with err filled, and `result` is zeroed. */
-int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
-                    gp_result *result, gp_error *err);
+GP_API int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
+                           gp_result *result, gp_error *err);
 
 /* Rebuilds, from the final disks in result->packing (what a store keeps) and the spec,
  * what the stages after packing derived from them: F and its statistics when the spec
@@ -49,12 +50,12 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
  * sweeps) is not rebuilt: result->balance.after_only is set and the writers leave it
  * out. Returns 0 or the stage's error code with err filled (result then keeps only
  * what it had). */
-int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err);
+GP_API int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err);
 
-void gp_result_free(gp_result *result);
+GP_API void gp_result_free(gp_result *result);
 
 /* Seconds spent in `stage`, or 0 if it did not run. */
-double gp_result_stage_seconds(const gp_result *result, const char *stage);
+GP_API double gp_result_stage_seconds(const gp_result *result, const char *stage);
 
 #ifdef __cplusplus
 }

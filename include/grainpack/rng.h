@@ -6,6 +6,8 @@
 
 #include <stdint.h>
 
+#include "grainpack/api.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -15,13 +17,13 @@ typedef struct gp_rng {
 } gp_rng;
 
 /* Initialises rng from a 64-bit seed; every seed (0 included) gives a valid state. */
-void gp_rng_seed(gp_rng *rng, uint64_t seed);
+GP_API void gp_rng_seed(gp_rng *rng, uint64_t seed);
 
 /* The next 64 random bits. */
-uint64_t gp_rng_next(gp_rng *rng);
+GP_API uint64_t gp_rng_next(gp_rng *rng);
 
 /* A double uniform in [0, 1), with 53 random bits. */
-double gp_rng_uniform(gp_rng *rng);
+GP_API double gp_rng_uniform(gp_rng *rng);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/api.h"
 #include "grainpack/balance.h"
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
@@ -62,20 +63,20 @@ typedef struct gp_spec {
  * (not JSON), GP_EINVAL (invalid field) or GP_ETOOBIG (over a cap), fills err with the
  * JSON pointer of the field (as it appears in `text`) and what was expected, and leaves
  * `spec` zeroed. */
-int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
-                  gp_error *err);
+GP_API int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
+                         gp_error *err);
 
 /* Reads and parses a spec file (as gp_spec_parse; GP_EIO if it cannot be read). */
-int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
-                      gp_error *err);
+GP_API int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
+                             gp_error *err);
 
 /* The expected number of disks: a packing density of ~0.86 over the mean packing-disk
  * area. Used for the disk cap and for capacity guesses. */
-double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
-                              const gp_joint *joint);
+GP_API double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
+                                     const gp_joint *joint);
 
 /* Frees what the spec owns and zeroes it. */
-void gp_spec_free(gp_spec *spec);
+GP_API void gp_spec_free(gp_spec *spec);
 
 #ifdef __cplusplus
 }

@@ -4,6 +4,7 @@
 
 #include <stddef.h>
 
+#include "grainpack/api.h"
 #include "grainpack/distribution.h"
 #include "grainpack/domain.h"
 #include "grainpack/laguerre.h"
@@ -40,10 +41,10 @@ typedef struct gp_pack_stats {
 
 /* Computes the statistics of `packing` against `dist` in `domain`. Returns 0 or
  * GP_ENOMEM; on success `out` owns its bins (free with gp_pack_stats_free). */
-int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
-                          const gp_packing *packing, gp_pack_stats *out);
+GP_API int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
+                                 const gp_packing *packing, gp_pack_stats *out);
 
-void gp_pack_stats_free(gp_pack_stats *stats);
+GP_API void gp_pack_stats_free(gp_pack_stats *stats);
 
 /* Bins of the cell-area histogram, over [min, max] of the areas. */
 #define GP_CELL_AREA_BINS 10
@@ -70,23 +71,23 @@ typedef struct gp_cell_stats {
 /* Computes the statistics of `cells` (one per disk of `disks`) in `domain` against
  * `dist`. Returns 0 or GP_ENOMEM; on success `out` owns its arrays (free with
  * gp_cell_stats_free). */
-int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
-                          const gp_disk *disks, const gp_cells *cells, gp_cell_stats *out);
+GP_API int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
+                                 const gp_disk *disks, const gp_cells *cells, gp_cell_stats *out);
 
-void gp_cell_stats_free(gp_cell_stats *stats);
+GP_API void gp_cell_stats_free(gp_cell_stats *stats);
 
 /* The achieved-versus-target table of `dist`: its report bins (gp_distribution_report_bins)
  * with zero counts. Returns 0 or GP_ENOMEM; *bins is the caller's to free. */
-int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **bins, size_t *nbins);
+GP_API int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **bins, size_t *nbins);
 
 /* The bin holding r among bins sorted by min, or -1 when r lies in none of them. */
-long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
+GP_API long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
 
 /* Fills `achieved`, `se` and `z` of every bin from its count out of n values, and *max_abs_z. */
-void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
+GP_API void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
 
 /* The upper tail P(X >= x) of a chi-square law with dof degrees of freedom (dof >= 1). */
-double gp_chi2_upper_tail(double x, int dof);
+GP_API double gp_chi2_upper_tail(double x, int dof);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/api.h"
 #include "grainpack/disk.h"
 #include "grainpack/error.h"
 
@@ -32,17 +33,17 @@ typedef struct gp_rt gp_rt;
  * hidden vertex: its disk lies inside the power cells of others, which non-overlapping
  * packing disks never do; also two disks with the same centre), or GP_EINTERNAL when CGAL
  * reports a failure; err says which disk or what CGAL said, and *out is NULL. */
-int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err);
+GP_API int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err);
 
 /* Frees the triangulation (no-op on NULL). */
-void gp_rt_free(gp_rt *rt) GP_RT_NOEXCEPT;
+GP_API void gp_rt_free(gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The number of vertices (= disks). */
-size_t gp_rt_count(const gp_rt *rt) GP_RT_NOEXCEPT;
+GP_API size_t gp_rt_count(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The dimension of the triangulation: -1 empty, 0 one vertex, 1 all centres collinear,
  * 2 otherwise. Only dimension 2 has interior vertices and balls. */
-int gp_rt_dimension(const gp_rt *rt) GP_RT_NOEXCEPT;
+GP_API int gp_rt_dimension(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 /* The neighbours of vertex `id` (its ring), counter-clockwise around it. Writes the
  * first `cap` of them to `out` and returns how many there are (call again with a larger
@@ -58,8 +59,8 @@ int gp_rt_dimension(const gp_rt *rt) GP_RT_NOEXCEPT;
  * (p, out[0]) and (out[degree-1], p) are hull edges. An interior vertex's ring starts at
  * its smallest id: the same triangulation always gives the same ring, however it was
  * built or updated. */
-size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
-                  int *on_hull) GP_RT_NOEXCEPT;
+GP_API size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
+                         int *on_hull) GP_RT_NOEXCEPT;
 
 /* How to bring the triangulation up to date after centres moved. */
 typedef enum gp_rt_update {
@@ -85,13 +86,14 @@ typedef struct gp_rt_update_stats {
  * moved; `disks` is the array it was built from, with the new positions (the radii must
  * not have changed). Returns 0 or, as gp_rt_build, GP_ENOMEM, GP_EGEOM or GP_EINTERNAL;
  * on failure the triangulation must only be freed. `stats` may be NULL. */
-int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks, const int32_t *ids,
-                       size_t nids, gp_rt_update mode, gp_rt_update_stats *stats, gp_error *err);
+GP_API int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks, const int32_t *ids,
+                              size_t nids, gp_rt_update mode, gp_rt_update_stats *stats,
+                              gp_error *err);
 
 /* Whether the triangulation is a valid regular triangulation of its current points
  * (CGAL's own check: every triangle counter-clockwise, every edge locally regular, no
  * hidden vertex). Costly; for the tests. */
-int gp_rt_is_regular(const gp_rt *rt) GP_RT_NOEXCEPT;
+GP_API int gp_rt_is_regular(const gp_rt *rt) GP_RT_NOEXCEPT;
 
 #ifdef __cplusplus
 }

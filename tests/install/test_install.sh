@@ -2,7 +2,10 @@
 # test_install.sh - `cmake --install` into a temporary prefix gives what a Debian machine
 # expects, and a program builds against the installed library and runs, found both ways
 # a user finds it: find_package(grainpack) (shared and static) and pkg-config (shared and
-# static). The systemd unit passes `systemd-analyze verify`, and `systemd-analyze
+# static), including <grainpack/grainpack.h> alone in strict C11 (-pedantic, warnings as
+# errors). The libraries offer exactly the functions the installed headers declare: the
+# shared one exports nothing else, the archive defines no other global name (internal
+# helpers such as front_* are hidden, or local). The systemd unit passes `systemd-analyze verify`, and `systemd-analyze
 # security` rates its sandbox (both where systemd-analyze exists). A configuration
 # without the tests looks for neither node nor python.
 # Usage: test_install.sh BUILD_DIR SOURCE_DIR LIBDIR SBINDIR [CONSUMER_FLAGS]
@@ -38,6 +41,39 @@ echo "shared library: SONAME $soname"
 ! grep -q -- "-W\|-fsanitize\|-flto" "$prefix/$libdir/cmake/grainpack/grainpackTargets.cmake" ||
   fail "the exported targets carry the project's compiler flags"
 
+# the public API: the umbrella header alone, in strict C11, and the functions it declares
+# (GCC's -aux-info lists every prototype it saw, with its file), which must be exactly
+# what the libraries export. The headers include nothing but the C library's and their own.
+strict="-std=c11 -Wall -Wextra -Werror -pedantic"
+printf '#include <grainpack/grainpack.h>\nint main(void) { return gp_version()[0] == 0; }\n' > "$tmp/umbrella.c"
+if cc $strict -I"$prefix/include" -aux-info "$tmp/aux.txt" -c "$tmp/umbrella.c" -o "$tmp/umbrella.o" 2> "$tmp/umbrella.log"; then
+  grep "^/\* $prefix/include/grainpack/" "$tmp/aux.txt" | grep -v '\*/ static ' |
+    sed -n 's/.*\*\/ extern [^(]*[ *]\(gp_[a-z0-9_]*\) (.*/\1/p' | sort -u > "$tmp/declared"
+  echo "grainpack/grainpack.h alone compiles with $strict: $(wc -l < "$tmp/declared") functions declared"
+else
+  cat "$tmp/umbrella.log"; fail "grainpack/grainpack.h alone does not compile with $strict"
+fi
+others=$(grep -h '^#include <' "$prefix"/include/grainpack/*.h | sort -u |
+         grep -v '<\(stddef\|stdint\|stdio\|stdarg\|stdatomic\)\.h>\|<atomic>') &&
+  fail "the installed headers include $others"
+nm -D --defined-only "$prefix/$libdir/libgrainpack.so" | awk '{print $NF}' | sort -u > "$tmp/exported"
+if cmp -s "$tmp/declared" "$tmp/exported"; then
+  echo "shared library: exports the $(wc -l < "$tmp/exported") functions of the headers, nothing else"
+else
+  fail "the shared library's exports differ from the headers' functions:" \
+       "$(diff "$tmp/declared" "$tmp/exported" | grep '^[<>]' | head -20 | tr '\n' ' ')"
+fi
+# the archive: global names defined strongly (T, D, B, R); weak and unique ones (V, W,
+# u) are C++ template instances, merged with a program's own copies by the linker
+nm -g --defined-only "$prefix/$libdir/libgrainpack.a" | awk 'NF == 3 && $2 ~ /^[TDBR]$/ {print $3}' |
+  sort -u > "$tmp/archived"
+if cmp -s "$tmp/declared" "$tmp/archived"; then
+  echo "static library: defines the $(wc -l < "$tmp/archived") functions of the headers as its only global names"
+else
+  fail "the archive's global names differ from the headers' functions:" \
+       "$(diff "$tmp/declared" "$tmp/archived" | grep '^[<>]' | head -20 | tr '\n' ' ')"
+fi
+
 # the installed programs, the installed examples, the man pages
 version=$(sed -n 's/#define GP_VERSION "\(.*\)"/\1/p' "$prefix/include/grainpack/version.h")
 [ "$("$prefix/bin/grainpack" --version)" = "grainpack $version" ] || fail "grainpack --version"
@@ -66,14 +102,14 @@ fi
 
 # pkg-config: cc and nothing else, shared and static
 export PKG_CONFIG_PATH="$prefix/$libdir/pkgconfig"
-if cc -std=c11 $cflags "$src/tests/install/consumer/consumer.c" -o "$tmp/pc_shared" \
+if cc $strict $cflags "$src/tests/install/consumer/consumer.c" -o "$tmp/pc_shared" \
       $(pkg-config --cflags --libs grainpack) -lm 2> "$tmp/pc.log"; then
   out=$(LD_LIBRARY_PATH="$prefix/$libdir" "$tmp/pc_shared") || fail "pc_shared failed: $out"
   echo "pkg-config, shared: $out"
 else
   cat "$tmp/pc.log"; fail "pkg-config consumer did not build"
 fi
-if cc -std=c11 $cflags "$src/tests/install/consumer/consumer.c" -o "$tmp/pc_static" \
+if cc $strict $cflags "$src/tests/install/consumer/consumer.c" -o "$tmp/pc_static" \
       $(pkg-config --cflags grainpack) $(pkg-config --static --libs grainpack | sed 's/-lgrainpack\b/-l:libgrainpack.a/') 2> "$tmp/pc.log"; then
   out=$("$tmp/pc_static") || fail "pc_static failed: $out"
   echo "pkg-config, static: $out"

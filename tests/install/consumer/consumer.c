@@ -1,10 +1,8 @@
 /* consumer.c - a program built against the installed libgrainpack, as a user of the
- * library writes it: the headers from <grainpack/...>, nothing from the source tree. It
+ * library writes it: the one umbrella header, nothing from the source tree. It
  * packs a small domain, balances it and builds the Laguerre cells (the C++ part of the
  * library), checks what came out, and prints one line. Exit status 0 when all is right. */
-#include <grainpack/pipeline.h>
-#include <grainpack/spec.h>
-#include <grainpack/version.h>
+#include <grainpack/grainpack.h>
 
 #include <math.h>
 #include <stdio.h>

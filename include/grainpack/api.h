@@ -1,0 +1,14 @@
+/* api.h - GP_API marks the functions libgrainpack exports. The library is compiled with
+ * hidden visibility by default, so its shared object exports these and nothing else (no
+ * internal helper, no CGAL instantiation), and the installed static archive keeps only
+ * them global (dist/localize_archive.cmake). */
+#ifndef GRAINPACK_API_H
+#define GRAINPACK_API_H
+
+#if defined(__GNUC__) && __GNUC__ >= 4
+#define GP_API __attribute__((visibility("default")))
+#else
+#define GP_API
+#endif
+
+#endif
