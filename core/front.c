@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "grainpack/error.h"
+#include "grow.h"
 
 /* Two disks whose gap is below this fraction of their radii touch: the segment between
  * them is covered by the disks themselves and needs no barrier. Same reasoning as
@@ -45,7 +46,7 @@ int front_reserve_disks(front *f, size_t capacity)
 {
     if (capacity <= f->disk_capacity)
         return 0;
-    int32_t *first = realloc(f->first_node, capacity * sizeof *first);
+    int32_t *first = grow_realloc(f->first_node, capacity, sizeof *first);
     if (!first)
         return GP_ENOMEM;
     f->first_node = first;
@@ -64,13 +65,11 @@ static int grow_buckets(front *f, uint32_t level)
 {
     if (level < f->nbuckets)
         return 0;
-    uint32_t n = f->nbuckets ? f->nbuckets : 16;
-    while (n <= level)
-        n *= 2;
-    front_bucket *grown = realloc(f->buckets, n * sizeof *grown);
+    size_t n = grow_capacity(f->nbuckets, (size_t)level + 1);
+    front_bucket *grown = n <= UINT32_MAX ? grow_realloc(f->buckets, n, sizeof *grown) : NULL;
     if (!grown)
         return GP_ENOMEM;
-    for (uint32_t i = f->nbuckets; i < n; i++) {
+    for (size_t i = f->nbuckets; i < n; i++) {
         front_bucket *b = &grown[i];
         b->untried = FRONT_NONE;
         for (int c = 0; c < FRONT_FAIL_CLASSES; c++)
@@ -78,7 +77,7 @@ static int grow_buckets(front *f, uint32_t level)
         memset(b->failed_mask, 0, sizeof b->failed_mask);
     }
     f->buckets = grown;
-    f->nbuckets = n;
+    f->nbuckets = (uint32_t)n;
     return 0;
 }
 
@@ -277,14 +276,10 @@ static int register_barrier(front *f, int32_t u)
         for (int32_t cx = range[0]; cx <= range[2]; cx++) {
             int32_t link = f->free_link;
             if (link == FRONT_NONE) {
-                if (f->nlinks == f->link_capacity) {
-                    size_t cap = 2 * f->link_capacity + 256;
-                    front_link *grown = realloc(f->links, cap * sizeof *grown);
-                    if (!grown)
-                        return GP_ENOMEM;
-                    f->links = grown;
-                    f->link_capacity = cap;
-                }
+                front_link *grown = grow(f->links, &f->link_capacity, f->nlinks + 1, sizeof *grown);
+                if (!grown)
+                    return GP_ENOMEM;
+                f->links = grown;
                 link = (int32_t)f->nlinks++;
             } else {
                 f->free_link = f->links[link].next;
@@ -394,14 +389,10 @@ static int32_t new_node(front *f, int32_t disk, uint32_t loop)
         u = f->free_node;
         f->free_node = f->nodes[u].next;
     } else {
-        if (f->nnodes == f->node_capacity) {
-            size_t cap = f->node_capacity * 2 + 64;
-            front_node *nodes = realloc(f->nodes, cap * sizeof *nodes);
-            if (!nodes)
-                return GP_ENOMEM;
-            f->nodes = nodes;
-            f->node_capacity = cap;
-        }
+        front_node *nodes = grow(f->nodes, &f->node_capacity, f->nnodes + 1, sizeof *nodes);
+        if (!nodes)
+            return GP_ENOMEM;
+        f->nodes = nodes;
         u = (int32_t)f->nnodes++;
     }
     front_node *n = &f->nodes[u];

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "grainpack/error.h"
+#include "grow.h"
 
 int gp_grid_init(gp_grid *grid, const gp_domain *domain, double R_max, size_t capacity,
                  size_t max_cells)
@@ -50,7 +51,7 @@ int gp_grid_reserve(gp_grid *grid, size_t capacity)
 {
     if (capacity <= grid->capacity)
         return 0;
-    int32_t *next = realloc(grid->next, capacity * sizeof *next);
+    int32_t *next = grow_realloc(grid->next, capacity, sizeof *next);
     if (!next)
         return GP_ENOMEM;
     grid->next = next;

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grow.h"
+
 /* Cells between two progress reports and cancel checks: a few milliseconds of work. */
 #define CELLS_PER_REPORT 16384
 
@@ -54,11 +56,11 @@ static int polygon_reserve(polygon *p, size_t cap)
 {
     if (cap <= p->cap)
         return 0;
-    double *u = realloc(p->u, 2 * cap * sizeof *u);
+    double *u = cap <= SIZE_MAX / 2 ? grow_realloc(p->u, 2 * cap, sizeof *u) : NULL;
     if (!u)
         return GP_ENOMEM;
     p->u = u;
-    int32_t *label = realloc(p->label, cap * sizeof *label);
+    int32_t *label = grow_realloc(p->label, cap, sizeof *label);
     if (!label)
         return GP_ENOMEM;
     p->label = label;
@@ -146,22 +148,6 @@ typedef struct builder {
     gp_cells *out;
     size_t nxy, xy_cap, nnb, nb_cap; /* used and allocated entries of out->xy / neighbours */
 } builder;
-
-/* `array` (capacity *cap elements of `size` bytes) with room for `need` elements:
- * itself, or a larger copy (the capacity doubled until it fits), or NULL when out of
- * memory (the array is then untouched). */
-static void *grow(void *array, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap)
-        return array;
-    size_t cap2 = *cap ? *cap : 64;
-    while (cap2 < need)
-        cap2 *= 2;
-    void *grown = realloc(array, cap2 * size);
-    if (grown)
-        *cap = cap2;
-    return grown;
-}
 
 /* The power cell of disk i clipped to the domain, into bd->a; its ring in bd->ring.
  * *holds_centre is cleared when the centre is not strictly inside every half-plane: a

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "grainpack/error.h"
+#include "grow.h"
 
 int gp_out_init(gp_out *o, size_t capacity, gp_out_sink sink, void *ctx)
 {
@@ -56,15 +57,10 @@ static int reserve(gp_out *o, size_t len)
         if (o->cap >= len)
             return 0;
     }
-    size_t cap = o->cap ? o->cap : GP_OUT_DEFAULT_CAPACITY;
-    while (cap - o->len < len) {
-        if (cap > SIZE_MAX / 2) {
-            o->err = GP_ENOMEM;
-            return o->err;
-        }
-        cap *= 2;
-    }
-    char *grown = realloc(o->buf, cap);
+    size_t cap = len <= SIZE_MAX - o->len
+                     ? grow_capacity(o->cap ? o->cap : GP_OUT_DEFAULT_CAPACITY, o->len + len)
+                     : 0;
+    char *grown = cap ? grow_realloc(o->buf, cap, 1) : NULL;
     if (!grown) {
         o->err = GP_ENOMEM;
         return o->err;

@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grow.h"
+
 /* Packing density assumed by the disk-count estimate: a little above what the front
  * reaches (0.80-0.88), so that the estimate errs on the high side. */
 #define EXPECTED_FILL 0.90
@@ -555,6 +557,10 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
     return rc;
 }
 
+/* Room a spec file read asks for at each fread beyond what it holds: specs are a few
+ * hundred bytes to a few megabytes (a long histogram); the buffer doubles as it fills. */
+#define READ_CHUNK 4096
+
 int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
                       gp_error *err)
 {
@@ -566,15 +572,12 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
     size_t len = 0, cap = 0;
     int rc = 0;
     for (;;) {
-        if (len + 4096 > cap) {
-            cap = cap ? cap * 2 : 65536;
-            char *grown = realloc(text, cap);
-            if (!grown) {
-                rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory reading %s", path);
-                break;
-            }
-            text = grown;
+        char *grown = grow(text, &cap, len + READ_CHUNK, 1);
+        if (!grown) {
+            rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory reading %s", path);
+            break;
         }
+        text = grown;
         size_t got = fread(text + len, 1, cap - len, f);
         len += got;
         if (got == 0) {
