@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "grid.h"
+#include "grow.h"
 
 /* Steps tried toward the target, as fractions w of the way: from the largest allowed
  * (gp_balance_params.max_step) down by 0.05 to 0.05, as report Algorithm 3 does from
@@ -41,11 +42,10 @@ static size_t ring_of(const gp_rt *rt, int32_t id, ring_buffer *buf, int *on_hul
         size_t degree = gp_rt_ring(rt, id, buf->ids, buf->cap, on_hull);
         if (degree <= buf->cap)
             return degree;
-        int32_t *grown = realloc(buf->ids, 2 * degree * sizeof *grown);
+        int32_t *grown = grow(buf->ids, &buf->cap, degree, sizeof *grown);
         if (!grown)
             return (size_t)-1;
         buf->ids = grown;
-        buf->cap = 2 * degree;
     }
 }
 

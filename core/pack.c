@@ -13,6 +13,7 @@
 
 #include "front.h"
 #include "grid.h"
+#include "grow.h"
 
 /* Fraction of the domain a packing is expected to fill: used for the capacity guess and
  * to turn the filled area into a progress fraction. */
@@ -60,15 +61,15 @@ static void draw_radius(packer *pk)
 static int grow_disks(packer *pk)
 {
     size_t cap = pk->capacity + pk->capacity / 2 + 64;
-    gp_disk *disks = realloc(pk->disks, cap * sizeof *disks);
+    gp_disk *disks = grow_realloc(pk->disks, cap, sizeof *disks);
     if (!disks)
         return GP_ENOMEM;
     pk->disks = disks;
-    uint32_t *level = realloc(pk->level, cap * sizeof *level);
+    uint32_t *level = grow_realloc(pk->level, cap, sizeof *level);
     if (!level)
         return GP_ENOMEM;
     pk->level = level;
-    uint8_t *closings = realloc(pk->closings, cap * sizeof *closings);
+    uint8_t *closings = grow_realloc(pk->closings, cap, sizeof *closings);
     if (!closings)
         return GP_ENOMEM;
     pk->closings = closings;
@@ -182,15 +183,12 @@ static int build_initial_front(packer *pk)
          * it sits where the corner disk would for its own radius */
         double clear = (nx[p] * ex[i] + ny[p] * ey[i]) / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
         for (;;) {
-            if (loop_len == loop_cap) {
-                int32_t *grown = realloc(loop, 2 * loop_cap * sizeof *loop);
-                if (!grown) {
-                    rc = gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
-                    break;
-                }
-                loop = grown;
-                loop_cap *= 2;
+            int32_t *grown = grow(loop, &loop_cap, loop_len + 1, sizeof *loop);
+            if (!grown) {
+                rc = gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
+                break;
             }
+            loop = grown;
             loop[loop_len++] = prev;
             double R = pk->pending_R, t = clear * R;
             double t_prev = (pk->disks[prev].x - vx[i]) * ex[i] + (pk->disks[prev].y - vy[i]) * ey[i];
@@ -343,12 +341,10 @@ static long gather_conflicts(packer *pk, double x, double y, int32_t u)
                              seg_to(pk, u), pk->conflicts, pk->conflict_capacity);
         if (n + 2 <= pk->conflict_capacity)
             break;
-        size_t cap = n + 16;
-        int32_t *grown = realloc(pk->conflicts, cap * sizeof *grown);
+        int32_t *grown = grow(pk->conflicts, &pk->conflict_capacity, n + 2, sizeof *grown);
         if (!grown)
             return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory closing the front");
         pk->conflicts = grown;
-        pk->conflict_capacity = cap;
     }
     int32_t barrier = front_barrier_crossed(&pk->fr, x, y, pk->pending_R, u);
     if (barrier != FRONT_NONE) {
