@@ -48,15 +48,15 @@ enum { SEG_UNTRIED = 0, SEG_FAILED, SEG_FROZEN };
  * under 1% of it, which is how finely "failed for a radius <= R" is told. */
 #define FRONT_FAIL_CLASSES 128
 
-/* The segments of one level still to work: the untried ones in a list, newest first (the
- * front sweeps on from the last placement, as the report's in-place list does), and the
- * failed ones in one list per class of the radius they failed for. */
 /* One registration of a barrier in one grid cell. */
 typedef struct front_link {
     int32_t node; /* whose segment is the barrier */
     int32_t next; /* next registration in the same cell; next free one when unused */
 } front_link;
 
+/* The segments of one level still to work: the untried ones in a list, newest first (the
+ * front sweeps on from the last placement, as the report's in-place list does), and the
+ * failed ones in one list per class of the radius they failed for. */
 typedef struct front_bucket {
     int32_t untried;        /* newest untried segment, FRONT_NONE if none */
     int32_t failed[FRONT_FAIL_CLASSES]; /* newest failed segment of each class */

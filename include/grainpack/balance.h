@@ -56,8 +56,10 @@ GP_API const char *gp_balance_method_name(gp_balance_method method);
 /* The largest step toward the target, as a fraction w of the way; smaller ones follow
  * by 0.05 down to 0.05. The report (Algorithm 3, docs/method.md §4.4) starts at w = 0.30. Our
  * default starts at the whole way: on the report's fixed-radius case the report's 0.30
- * leaves F_max at 1.71 where the whole way reaches 1.32 (the report: 1.33), and the mean
- * F ends lower on all the reference cases (bench/RESULTS.md). */
+ * leaves F_max at 1.64 where the whole way reaches 1.32 (the report: 1.33), and F_max
+ * ends lower on every reference case (variable 2.80 against 3.90, iron 1.89 against
+ * 2.97); the mean F too, but for the fixed case (0.128 against 0.121)
+ * (bench/GEOM_RESULTS.md, docs/method.md §4.6). */
 #define GP_BALANCE_REPORT_MAX_STEP 0.30
 #define GP_BALANCE_DEFAULT_MAX_STEP 1.0
 

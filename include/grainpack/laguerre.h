@@ -1,6 +1,6 @@
 /* laguerre.h - polygonal grains (docs/method.md §5, report §V): the power (Laguerre) cells of the
- * disk centres with weights w = R = r + j(r), clipped to the domain so that they tile it,
- * then shrunk to leave the grain-boundary band. */
+ * packing disks (centre, radius R = r + j(r): power weight R^2, as in triangulation.h),
+ * clipped to the domain so that they tile it, then shrunk to leave the grain-boundary band. */
 #ifndef GRAINPACK_LAGUERRE_H
 #define GRAINPACK_LAGUERRE_H
 

@@ -44,9 +44,10 @@ typedef struct gp_packing {
 } gp_packing;
 
 /* Packs the domain (docs/method.md §3.5) until the front is empty. On success returns 0 and `out`
- * owns its disks (free with gp_packing_free). On failure returns GP_ENOMEM, GP_ECANCELED,
- * GP_ETOOBIG (max_disks reached) or GP_EINTERNAL (the front failed to close: a bug), sets
- * err, and leaves `out` zeroed. */
+ * owns its disks (free with gp_packing_free). On failure returns GP_EINVAL (the largest
+ * packing disk does not fit in the domain), GP_ETOOBIG (max_disks reached, or the bucket
+ * grid would be too large for the domain), GP_ENOMEM or GP_ECANCELED, sets err, and leaves
+ * `out` zeroed. */
 GP_API int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
                    gp_error *err);
 

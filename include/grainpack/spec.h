@@ -70,8 +70,9 @@ GP_API int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *lim
 GP_API int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
                              gp_error *err);
 
-/* The expected number of disks: a packing density of ~0.86 over the mean packing-disk
- * area. Used for the disk cap and for capacity guesses. */
+/* The expected number of disks: a packing density of 0.90 (a little above the 0.80-0.88
+ * the front reaches, so that the estimate errs on the high side) over the mean
+ * packing-disk area. Used for the disk cap. */
 GP_API double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
                                      const gp_joint *joint);
 
