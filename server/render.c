@@ -141,15 +141,15 @@ int gp_render_format(const gp_spec *spec, const gp_result *result, gp_format for
                      char **body, size_t *len)
 {
     *body = NULL;
-    FILE *f = open_memstream(body, len);
-    if (!f)
-        return GP_ENOMEM;
-    int rc = gp_write_result(f, format, spec, result);
-    if (fclose(f) != 0 && rc == 0)
-        rc = GP_ENOMEM;
+    gp_out out;
+    int rc = gp_out_init(&out, 0, NULL, NULL);
+    if (rc == 0)
+        rc = gp_write_result(&out, format, spec, result);
     if (rc) {
-        free(*body);
-        *body = NULL;
+        gp_out_free(&out);
+        return rc;
     }
-    return rc;
+    *body = out.buf; /* the caller's now */
+    *len = out.len;
+    return 0;
 }

@@ -1,5 +1,5 @@
 /* out.h - a buffered byte sink, and the number formats every writer uses: the shortest
- * decimal that reads back to the same double (double-conversion, from Debian), fixed
+ * decimal that reads back to the same double (Dragonbox, from Debian), fixed
  * decimals for picture coordinates, integers. Writers emit into a gp_out; where the bytes
  * go (a FILE, a growing buffer a server drains piece by piece) is the sink's business. */
 #ifndef GRAINPACK_OUT_H
@@ -55,6 +55,10 @@ void gp_out_double(gp_out *o, double x);
 void gp_out_fixed(gp_out *o, double x, int decimals);
 void gp_out_int(gp_out *o, int64_t v);
 void gp_out_uint(gp_out *o, uint64_t v);
+/* printf into the buffer: for captions and other text off the hot paths (at most
+ * GP_OUT_PRINTF_MAX bytes; longer text is cut). */
+#define GP_OUT_PRINTF_MAX 1024
+void gp_out_printf(gp_out *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
 
 /* Hands what is buffered to the sink (no-op in memory mode). Returns o->err. */
 int gp_out_flush(gp_out *o);

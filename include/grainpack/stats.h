@@ -28,6 +28,7 @@ typedef struct gp_pack_stats {
     double packing_density;  /* sum pi R^2 / area */
     double grain_fraction;   /* sum pi r^2 / area */
     double r_min, r_max, r_mean; /* achieved grain radii (0 without disks) */
+    double joint_min, joint_max; /* of the joint thickness R - r (0 without disks) */
     size_t nbins;
     gp_bin_stat *bins;       /* owned */
     double chi2;             /* Pearson's statistic over bins with target > 0 */
