@@ -51,6 +51,8 @@ void gp_pack_stats_free(gp_pack_stats *stats);
  * grain-boundary band, and how the cells' equivalent radii compare with the target law. */
 typedef struct gp_cell_stats {
     size_t count;
+    size_t vertices;         /* over all cells */
+    size_t neighbour_links;  /* entries of all neighbour lists (twice the pairs) */
     double area_min, area_max, area_mean;  /* of the (shrunk) cells */
     size_t area_histogram[GP_CELL_AREA_BINS];
     double neighbours_mean;
