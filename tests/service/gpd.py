@@ -248,23 +248,29 @@ class Daemon:
 
 def check_store(checks, daemon, what):
     """The database file is sound and holds no half-written result: integrity_check is
-    ok; every successful job has its disks (32 bytes each, as many as its count), its
-    per-bin statistics and its stage timings; no other job has a result. Returns the
+    ok; every successful job has its summary and its disks (32 bytes each, as many as its
+    count, in chunks adding up to the section), its per-bin statistics and its stage
+    timings; no other job has a result, and no chunk is left of a deleted one. Returns the
     {id: status} of every job."""
     db = daemon.db()
     try:
         checks.check(db.execute("PRAGMA integrity_check").fetchone()[0] == "ok", f"{what}: integrity_check")
         bad = db.execute(
-            "SELECT j.id, j.status, j.count, r.count, length(r.disks),"
-            " (SELECT count(*) FROM bin_stats b WHERE b.job_id = j.id),"
-            " (SELECT count(*) FROM stage_timings t WHERE t.job_id = j.id)"
-            " FROM jobs j LEFT JOIN results r ON r.job_id = j.id"
-            " WHERE (j.status = 'successful' AND (r.count IS NULL OR r.count != j.count"
-            "   OR length(r.disks) != 32 * j.count"
+            "SELECT j.id, j.status, j.count, d.bytes,"
+            " (SELECT sum(length(c.data)) FROM result_chunks c WHERE c.section = d.id)"
+            " FROM jobs j LEFT JOIN result_sections d ON d.job_id = j.id AND d.tag = 'disks'"
+            " WHERE (j.status = 'successful' AND (d.bytes IS NULL OR d.bytes != 32 * j.count"
+            "   OR (j.count > 0 AND (SELECT sum(length(c.data)) FROM result_chunks c"
+            "                        WHERE c.section = d.id) != d.bytes)"
+            "   OR NOT EXISTS (SELECT 1 FROM result_sections p WHERE p.job_id = j.id AND p.tag = 'pack')"
             "   OR NOT EXISTS (SELECT 1 FROM bin_stats b WHERE b.job_id = j.id)"
             "   OR NOT EXISTS (SELECT 1 FROM stage_timings t WHERE t.job_id = j.id)))"
-            " OR (j.status != 'successful' AND r.job_id IS NOT NULL)").fetchall()
+            " OR (j.status != 'successful' AND EXISTS"
+            "   (SELECT 1 FROM result_sections s WHERE s.job_id = j.id))").fetchall()
         checks.check(not bad, f"{what}: jobs with a half-written or stray result: {bad[:5]}")
+        orphans = db.execute("SELECT count(*) FROM result_chunks WHERE section NOT IN"
+                             " (SELECT id FROM result_sections)").fetchone()[0]
+        checks.check(orphans == 0, f"{what}: {orphans} result chunks belong to no result")
         return dict(db.execute("SELECT id, status FROM jobs").fetchall())
     finally:
         db.close()  # (a `with` block would leave it open)
