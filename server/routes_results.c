@@ -100,6 +100,10 @@ int gp_route_results(gp_request *req, gp_reply *reply)
     gp_body_stream *stream;
     if (gp_download_new(req->svc, &res, &spec, format, gzip, &stream) == 0) {
         gp_reply_stream(reply, 200, gp_format_media_type(format), stream);
+        /* libmicrohttpd 0.9.75 ends the headers of a HEAD answer to a chunked response with
+         * the last chunk ("0\r\n\r\n") although HEAD has no body: a client reusing the
+         * connection would read it as the next status line, so the connection closes */
+        reply->close = strcmp(req->method, "HEAD") == 0;
     } else {
         reply->nheaders = 0;
         gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory for a download");

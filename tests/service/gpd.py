@@ -4,6 +4,7 @@ that a response matches its schema in openapi.yaml, and a few assertions.
 
 Only Debian's python3 with python3-yaml and python3-jsonschema (see .ci/setup)."""
 
+import gzip
 import hashlib
 import http.client
 import json
@@ -299,9 +300,10 @@ class OpenAPI:
     def schema(self, name):
         return self.doc["components"]["schemas"][name]
 
-    def check(self, checks, method, template, resp):
-        """Checks that resp is documented for (method, template) and its body matches the
-        documented schema; returns whether it did."""
+    def check(self, checks, method, template, resp, body_schema=True):
+        """Checks that resp is documented for (method, template), with its required
+        headers, and that its body matches the documented schema (unless body_schema is
+        false: a large body another test checks); returns whether it did."""
         what = f"{method} {template} -> {resp.status}"
         op = self.doc["paths"].get(template, {}).get(method.lower())
         if not checks.check(op is not None, f"{what}: not in openapi.yaml"):
@@ -311,21 +313,38 @@ class OpenAPI:
             return False
         documented = self._deref(documented)
         ok = True
-        for header in documented.get("headers", {}):
-            ok &= checks.check(header.lower() in resp.headers, f"{what}: no {header} header")
-        content = documented.get("content", {})
+        for header, spec in documented.get("headers", {}).items():
+            spec = self._deref(spec)
+            present = header.lower() in resp.headers
+            if spec.get("required"):
+                ok &= checks.check(present, f"{what}: no {header} header")
+            if present:
+                value = resp.headers[header.lower()]
+                schema = self._deref(spec.get("schema", {}))
+                if schema.get("type") == "integer" and value.isdigit():
+                    value = int(value)
+                errors = self.validate(schema, value)
+                ok &= checks.check(not errors, f"{what}: header {header}: {errors[:2]}")
+        content = documented.get("content")
+        if not content:  # 304: no body
+            return checks.check(resp.body == b"", f"{what}: a body where none is documented") and ok
+        body = resp.body
+        if resp.headers.get("content-encoding") == "gzip":
+            body = gzip.decompress(body)
         media = content.get(resp.content_type)
         if not checks.check(media is not None,
                             f"{what}: content type {resp.content_type!r} not documented"):
             return False
         schema = media.get("schema", {})
+        if not body_schema:
+            return ok
         if resp.content_type.endswith("json"):
             try:
-                body = resp.json()
+                body = json.loads(body)
             except ValueError as e:
                 return checks.check(False, f"{what}: body is not JSON: {e}")
         else:
-            body = resp.body.decode("utf-8", "replace")
+            body = body.decode("utf-8", "replace")
         errors = self.validate(schema, body)
         return checks.check(not errors, f"{what}: body does not match its schema: {errors[:3]}") and ok
 
