@@ -5,7 +5,7 @@ static void header(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, "x,y,r,R\n");
+    GP_OUT_LITERAL(out, "x,y,r,R\n");
 }
 
 static void disk_line(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)

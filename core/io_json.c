@@ -254,9 +254,9 @@ void gp_out_json(gp_out *out, const json_t *value)
         break;
     case JSON_INTEGER: gp_out_int(out, (int64_t)json_integer_value(value)); break;
     case JSON_REAL: gp_out_double(out, json_real_value(value)); break;
-    case JSON_TRUE: gp_out_puts(out, "true"); break;
-    case JSON_FALSE: gp_out_puts(out, "false"); break;
-    case JSON_NULL: gp_out_puts(out, "null"); break;
+    case JSON_TRUE: GP_OUT_LITERAL(out, "true"); break;
+    case JSON_FALSE: GP_OUT_LITERAL(out, "false"); break;
+    case JSON_NULL: GP_OUT_LITERAL(out, "null"); break;
     }
 }
 
@@ -274,28 +274,27 @@ static void head(gp_writer *w, gp_out *out, int param)
 {
     (void)param;
     json_state *st = w->state;
-    gp_out_puts(out, "{\n\"domain\": {\"width\": ");
+    GP_OUT_LITERAL(out, "{\n\"domain\": {\"width\": ");
     gp_out_double(out, w->spec->domain.width);
-    gp_out_puts(out, ", \"height\": ");
+    GP_OUT_LITERAL(out, ", \"height\": ");
     gp_out_double(out, w->spec->domain.height);
-    gp_out_puts(out, "},\n\"statistics\": ");
+    GP_OUT_LITERAL(out, "},\n\"statistics\": ");
     gp_out_json(out, st->statistics);
     json_decref(st->statistics); /* written once: not needed any more */
     st->statistics = NULL;
-    gp_out_puts(out, ",\n\"disks\": [");
+    GP_OUT_LITERAL(out, ",\n\"disks\": [");
 }
 
-static void field(gp_out *out, const char *name, double v)
-{
-    gp_out_puts(out, name);
-    gp_out_double(out, v);
-}
+/* ,"name":value (the name a literal, with its quotes and colon). */
+#define field(out, name, v) (GP_OUT_LITERAL(out, name), gp_out_double(out, v))
 
 static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
 {
     (void)param;
     const gp_disk *d = &win->disks[j];
-    gp_out_puts(out, win->first + j ? ",\n{\"x\":" : "\n{\"x\":");
+    if (win->first + j)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"x\":");
     gp_out_double(out, d->x);
     field(out, ",\"y\":", d->y);
     field(out, ",\"r\":", d->r);
@@ -304,7 +303,7 @@ static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
         /* F is defined for interior centres only (balance.h) */
         double F = win->F[j];
         if (isnan(F))
-            gp_out_puts(out, ",\"F\":null");
+            GP_OUT_LITERAL(out, ",\"F\":null");
         else
             field(out, ",\"F\":", F);
     }
@@ -315,14 +314,14 @@ static void close_array(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, "\n]");
+    GP_OUT_LITERAL(out, "\n]");
 }
 
 static void open_cells(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, ",\n\"cells\": [");
+    GP_OUT_LITERAL(out, ",\n\"cells\": [");
 }
 
 /* "cells": one object per grain: its id (the index of its disk), centre, radius, polygon
@@ -333,35 +332,39 @@ static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
     (void)param;
     const gp_disk *d = &win->disks[j];
     size_t id = win->first + j;
-    gp_out_puts(out, id ? ",\n{\"id\":" : "\n{\"id\":");
+    if (id)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"id\":");
     gp_out_uint(out, id);
     field(out, ",\"x\":", d->x);
     field(out, ",\"y\":", d->y);
     field(out, ",\"r\":", d->r);
     field(out, ",\"area\":", win->area[j]);
-    gp_out_puts(out, ",\"polygon\":[");
+    GP_OUT_LITERAL(out, ",\"polygon\":[");
     for (size_t k = win->start[j]; k < win->start[j + 1]; k++) {
         const double *v = &win->xy[2 * (k - win->vertex_base)];
-        gp_out_puts(out, k > win->start[j] ? ",[" : "[");
+        if (k > win->start[j])
+            gp_out_char(out, ',');
+        gp_out_char(out, '[');
         gp_out_double(out, v[0]);
         gp_out_char(out, ',');
         gp_out_double(out, v[1]);
         gp_out_char(out, ']');
     }
-    gp_out_puts(out, "],\"neighbours\":[");
+    GP_OUT_LITERAL(out, "],\"neighbours\":[");
     for (size_t k = win->nstart[j]; k < win->nstart[j + 1]; k++) {
         if (k > win->nstart[j])
             gp_out_char(out, ',');
         gp_out_int(out, win->neighbours[k - win->neighbour_base]);
     }
-    gp_out_puts(out, "]}");
+    GP_OUT_LITERAL(out, "]}");
 }
 
 static void tail(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, "\n}\n");
+    GP_OUT_LITERAL(out, "\n}\n");
 }
 
 int gp_plan_json(gp_writer *w)

@@ -116,13 +116,9 @@ static int svg_decimals(const gp_spec *spec)
     return decimals < 0 ? 0 : (decimals > 9 ? 9 : decimals);
 }
 
-/* ' name="v"' with v at `dec` decimals. */
-static void attr(gp_out *out, const char *name, double v, int dec)
-{
-    gp_out_puts(out, name);
-    gp_out_fixed(out, v, dec);
-    gp_out_char(out, '"');
-}
+/* ' name="v"' with v at `dec` decimals (`name` a literal, up to the opening quote). */
+#define attr(out, name, v, dec) \
+    (GP_OUT_LITERAL(out, name), gp_out_fixed(out, v, dec), gp_out_char(out, '"'))
 
 /* Opens the group of colour class cls. */
 static void open_group(gp_writer *w, gp_out *out, int cls)
@@ -130,7 +126,7 @@ static void open_group(gp_writer *w, gp_out *out, int cls)
     svg_state *st = w->state;
     char color[8];
     class_color(cls, color);
-    gp_out_puts(out, "<g fill=\"");
+    GP_OUT_LITERAL(out, "<g fill=\"");
     gp_out_puts(out, color);
     gp_out_char(out, '"');
     if (!w->result->has_cells && st->rings.has_joint) {
@@ -138,14 +134,14 @@ static void open_group(gp_writer *w, gp_out *out, int cls)
         if (st->rings.constant)
             attr(out, " stroke-width=\"", st->rings.width, st->dec + 1);
     }
-    gp_out_puts(out, ">\n");
+    GP_OUT_LITERAL(out, ">\n");
 }
 
 static void close_group(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, "</g>\n");
+    GP_OUT_LITERAL(out, "</g>\n");
 }
 
 static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int cls)
@@ -160,7 +156,7 @@ static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
     attr(out, " r=\"", st->rings.has_joint ? 0.5 * (d->r + d->R) : d->r, dec + 1);
     if (st->rings.has_joint && !st->rings.constant)
         attr(out, " stroke-width=\"", d->R - d->r, dec + 1);
-    gp_out_puts(out, "/>\n");
+    GP_OUT_LITERAL(out, "/>\n");
 }
 
 static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int cls)
@@ -168,7 +164,7 @@ static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
     svg_state *st = w->state;
     if (grain_class(&st->c, win, j) != cls)
         return;
-    gp_out_puts(out, "<polygon points=\"");
+    GP_OUT_LITERAL(out, "<polygon points=\"");
     for (size_t k = win->start[j]; k < win->start[j + 1]; k++) {
         const double *v = &win->xy[2 * (k - win->vertex_base)];
         if (k > win->start[j])
@@ -177,7 +173,7 @@ static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
         gp_out_char(out, ',');
         gp_out_fixed(out, st->H - v[1], st->dec);
     }
-    gp_out_puts(out, "\"/>\n");
+    GP_OUT_LITERAL(out, "\"/>\n");
 }
 
 static void outline_group(gp_writer *w, gp_out *out, int param)
@@ -188,7 +184,7 @@ static void outline_group(gp_writer *w, gp_out *out, int param)
     gp_distribution_support(&w->spec->dist, &r_min, &r_max);
     gp_out_puts(out, "<g fill=\"none\" stroke=\"" OUTLINE "\"");
     attr(out, " stroke-width=\"", 0.04 * r_min, st->dec + 1);
-    gp_out_puts(out, ">\n");
+    GP_OUT_LITERAL(out, ">\n");
 }
 
 static void outline(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
@@ -199,15 +195,15 @@ static void outline(gp_writer *w, gp_out *out, const gp_grain_window *win, size_
     attr(out, "<circle cx=\"", d->x, st->dec);
     attr(out, " cy=\"", st->H - d->y, st->dec);
     attr(out, " r=\"", d->r, st->dec + 1);
-    gp_out_puts(out, "/>\n");
+    GP_OUT_LITERAL(out, "/>\n");
 }
 
 /* A rectangle over the domain, x = 0, y = 0, with what follows as its last attributes. */
 static void domain_rect(gp_writer *w, gp_out *out, const char *rest)
 {
-    gp_out_puts(out, "<rect x=\"0\" y=\"0\" width=\"");
+    GP_OUT_LITERAL(out, "<rect x=\"0\" y=\"0\" width=\"");
     gp_out_double(out, w->spec->domain.width);
-    gp_out_puts(out, "\" height=\"");
+    GP_OUT_LITERAL(out, "\" height=\"");
     gp_out_double(out, w->spec->domain.height);
     gp_out_puts(out, rest);
 }
@@ -235,18 +231,18 @@ static void head(gp_writer *w, gp_out *out, int param)
     gp_out_fixed(out, vh, dec);
     attr(out, "\" width=\"", vw * px, 0);
     attr(out, " height=\"", vh * px, 0);
-    gp_out_puts(out, ">\n<title>grainpack: ");
+    GP_OUT_LITERAL(out, ">\n<title>grainpack: ");
     gp_out_uint(out, stats->count);
-    gp_out_puts(out, " grains in ");
+    GP_OUT_LITERAL(out, " grains in ");
     gp_out_double(out, W);
-    gp_out_puts(out, " x ");
+    GP_OUT_LITERAL(out, " x ");
     gp_out_double(out, H);
     gp_out_printf(out, ", packing density %.4f</title>\n", stats->packing_density);
     attr(out, "<rect x=\"", -margin, st->dec);
     attr(out, " y=\"", -margin, st->dec);
     attr(out, " width=\"", vw, st->dec);
     attr(out, " height=\"", vh, st->dec);
-    gp_out_puts(out, " fill=\"white\"/>\n");
+    GP_OUT_LITERAL(out, " fill=\"white\"/>\n");
     domain_rect(w, out, "\" fill=\"" BACKGROUND "\"/>\n");
     if (w->result->has_cells) /* the band between the cells */
         domain_rect(w, out, "\" fill=\"" JOINT "\"/>\n");
@@ -266,7 +262,7 @@ static void legend(gp_writer *w, gp_out *out, int param)
     int dec = st->dec;
     domain_rect(w, out, "\" fill=\"none\" stroke=\"" OUTLINE "\"");
     attr(out, " stroke-width=\"", 0.002 * L, dec);
-    gp_out_puts(out, "/>\n");
+    GP_OUT_LITERAL(out, "/>\n");
     double bar_y = H + 0.03 * L, seg_w = W / COLOR_CLASSES;
     for (int cls = 0; cls < COLOR_CLASSES; cls++) {
         char color[8];
@@ -275,9 +271,9 @@ static void legend(gp_writer *w, gp_out *out, int param)
         attr(out, " y=\"", bar_y, dec);
         attr(out, " width=\"", seg_w * 1.01, dec);
         attr(out, " height=\"", bar_h, dec);
-        gp_out_puts(out, " fill=\"");
+        GP_OUT_LITERAL(out, " fill=\"");
         gp_out_puts(out, color);
-        gp_out_puts(out, "\"/>\n");
+        GP_OUT_LITERAL(out, "\"/>\n");
     }
     double text_y = bar_y + bar_h + 1.1 * font;
     attr(out, "<g font-family=\"sans-serif\" font-size=\"", font, dec);
@@ -312,7 +308,7 @@ static void legend(gp_writer *w, gp_out *out, int param)
         gp_out_printf(out, ">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
                       gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);
     }
-    gp_out_puts(out, "</g>\n</svg>\n");
+    GP_OUT_LITERAL(out, "</g>\n</svg>\n");
 }
 
 int gp_plan_svg(gp_writer *w)

@@ -28,18 +28,18 @@ static void head(gp_writer *w, gp_out *out, int param)
 {
     (void)param;
     const gp_result *r = w->result;
-    gp_out_puts(out, "# vtk DataFile Version 3.0\ngrainpack ");
+    GP_OUT_LITERAL(out, "# vtk DataFile Version 3.0\ngrainpack ");
     gp_out_puts(out, r->has_cells ? "cells: " : "disks: ");
     gp_out_uint(out, w->grains);
-    gp_out_puts(out, " grains in ");
+    GP_OUT_LITERAL(out, " grains in ");
     gp_out_double(out, w->spec->domain.width);
-    gp_out_puts(out, " x ");
+    GP_OUT_LITERAL(out, " x ");
     gp_out_double(out, w->spec->domain.height);
-    gp_out_puts(out, ", seed ");
+    GP_OUT_LITERAL(out, ", seed ");
     gp_out_uint(out, w->spec->seed);
-    gp_out_puts(out, "\nASCII\nDATASET POLYDATA\nPOINTS ");
+    GP_OUT_LITERAL(out, "\nASCII\nDATASET POLYDATA\nPOINTS ");
     gp_out_uint(out, r->has_cells ? w->source.vertex_count : w->grains);
-    gp_out_puts(out, " double\n");
+    GP_OUT_LITERAL(out, " double\n");
 }
 
 static void point(gp_out *out, double x, double y)
@@ -47,7 +47,7 @@ static void point(gp_out *out, double x, double y)
     gp_out_double(out, x);
     gp_out_char(out, ' ');
     gp_out_double(out, y);
-    gp_out_puts(out, " 0\n");
+    GP_OUT_LITERAL(out, " 0\n");
 }
 
 static void cell_points(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
@@ -70,7 +70,7 @@ static void centre(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t
 static void polygons_head(gp_writer *w, gp_out *out, int param)
 {
     (void)param;
-    gp_out_puts(out, "POLYGONS ");
+    GP_OUT_LITERAL(out, "POLYGONS ");
     gp_out_uint(out, w->grains);
     gp_out_char(out, ' ');
     gp_out_uint(out, w->grains + w->source.vertex_count);
@@ -92,7 +92,7 @@ static void polygon(gp_writer *w, gp_out *out, const gp_grain_window *win, size_
 static void vertices_head(gp_writer *w, gp_out *out, int param)
 {
     (void)param;
-    gp_out_puts(out, "VERTICES ");
+    GP_OUT_LITERAL(out, "VERTICES ");
     gp_out_uint(out, w->grains);
     gp_out_char(out, ' ');
     gp_out_uint(out, 2 * w->grains);
@@ -103,7 +103,7 @@ static void vertex(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t
 {
     (void)w;
     (void)param;
-    gp_out_puts(out, "1 ");
+    GP_OUT_LITERAL(out, "1 ");
     gp_out_uint(out, win->first + j);
     gp_out_char(out, '\n');
 }
@@ -119,11 +119,11 @@ static void data_head(gp_writer *w, gp_out *out, int param)
 static void array_head(gp_writer *w, gp_out *out, int param)
 {
     (void)w;
-    gp_out_puts(out, "SCALARS ");
+    GP_OUT_LITERAL(out, "SCALARS ");
     gp_out_puts(out, arrays[param].name);
     gp_out_char(out, ' ');
     gp_out_puts(out, arrays[param].type);
-    gp_out_puts(out, " 1\nLOOKUP_TABLE default\n");
+    GP_OUT_LITERAL(out, " 1\nLOOKUP_TABLE default\n");
 }
 
 static void value(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)

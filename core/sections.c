@@ -439,6 +439,10 @@ struct gp_sections_source {
     /* where grain `cursor` starts among the vertices and the neighbour entries: a pass
      * reads the grains in order, so the next window starts where the last one ended */
     size_t cursor, vertex_at, neighbour_at;
+    /* the window loaded last, and the arrays it holds: a writer stopped in the middle of
+     * a window (its output full) goes on from it without reading it again */
+    gp_grain_window last;
+    unsigned last_needs;
 };
 
 /* Makes room for n elements of `size` bytes in *buf (capacity *cap). */
@@ -523,8 +527,14 @@ static int load_cells(gp_sections_source *s, unsigned needs, size_t first, size_
 static int load(void *ctx, unsigned needs, size_t first, gp_grain_window *win)
 {
     gp_sections_source *s = ctx;
+    if (s->last.count && first >= s->last.first && first - s->last.first < s->last.count &&
+        (needs & ~s->last_needs) == 0) {
+        *win = s->last;
+        return 0;
+    }
     size_t total = s->summary->packing.count;
     size_t n = total - first < s->window ? total - first : s->window;
+    s->last.count = 0;
     memset(win, 0, sizeof *win);
     win->first = first;
     win->count = n;
@@ -540,6 +550,10 @@ static int load(void *ctx, unsigned needs, size_t first, gp_grain_window *win)
         win->area = s->area;
     if (!rc && (needs & (GP_GRAINS_POLYGONS | GP_GRAINS_NEIGHBOURS)))
         rc = load_cells(s, needs, first, n, win);
+    if (!rc) {
+        s->last = *win;
+        s->last_needs = needs;
+    }
     return rc;
 }
 

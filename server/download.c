@@ -10,9 +10,11 @@
 #include "grainpack/sections.h"
 #include "log.h"
 
-/* What the writer renders in one go before gzip takes it: deflate works best on large
- * inputs, and this bounds the plain text held besides the compressor's own window. */
-#define GZIP_INPUT ((size_t)64 * 1024)
+/* What the writer renders in one go: libmicrohttpd asks for as much as is free in its
+ * buffer, often a few hundred bytes; rendering that little each time would cost a store
+ * connection and a window of the result per grain. The rest waits in `text` for the next
+ * calls. Also what deflate is given at once (it works best on large inputs). */
+#define RENDER_BATCH ((size_t)64 * 1024)
 /* zlib's window bits (the largest, 32 KB) plus 16: gzip framing instead of zlib's. */
 #define GZIP_WINDOW_BITS (15 + 16)
 /* zlib's default memory level: 128 KB of hash tables. */
@@ -27,7 +29,8 @@ typedef struct gp_download {
     gp_result_reader *reader;
     gp_sections_source *source;
     gp_writer *writer;
-    gp_out text;       /* rendered, not yet handed on */
+    gp_out text;       /* rendered; bytes from `sent` on not handed on yet */
+    size_t sent;
     gp_db *db;         /* held during one fill only */
     int rendered;      /* the writer is done */
     int gzip, z_open, z_done;
@@ -69,11 +72,17 @@ static void let_go(gp_download *d)
 
 static long fill_plain(gp_download *d, char *buf, size_t max)
 {
-    int rc = render(d, max);
-    let_go(d);
-    if (rc)
-        return -1;
-    return (long)gp_out_take(&d->text, buf, max);
+    if (d->sent == d->text.len) { /* all handed on: a new batch */
+        d->text.len = d->sent = 0;
+        int rc = render(d, max > RENDER_BATCH ? max : RENDER_BATCH);
+        let_go(d);
+        if (rc)
+            return -1;
+    }
+    size_t n = d->text.len - d->sent < max ? d->text.len - d->sent : max;
+    memcpy(buf, d->text.buf + d->sent, n);
+    d->sent += n;
+    return (long)n;
 }
 
 static long fill_gzip(gp_download *d, char *buf, size_t max)
@@ -84,7 +93,7 @@ static long fill_gzip(gp_download *d, char *buf, size_t max)
     while (z->avail_out > 0 && !d->z_done) {
         if (z->avail_in == 0) {
             d->text.len = 0; /* deflate took it all */
-            if (render(d, GZIP_INPUT)) {
+            if (render(d, RENDER_BATCH)) {
                 let_go(d);
                 return -1;
             }
@@ -147,7 +156,7 @@ int gp_download_new(gp_service *svc, gp_stored_result *res, gp_spec *spec, gp_fo
     d->gzip = gzip;
     gp_metrics_download(svc->metrics, 1);
     gp_grain_source grains;
-    if (gp_out_init(&d->text, GZIP_INPUT, NULL, NULL) ||
+    if (gp_out_init(&d->text, 2 * RENDER_BATCH, NULL, NULL) ||
         !(d->reader = gp_result_reader_new(d->res.key)) ||
         !(d->source = gp_sections_source_new(&d->res.summary, read_section, d, 0)) ||
         (grains = gp_sections_source_grains(d->source),

@@ -45,6 +45,9 @@ int gp_out_init_file(gp_out *o, FILE *file);
 
 void gp_out_write(gp_out *o, const void *data, size_t len);
 void gp_out_puts(gp_out *o, const char *text);
+/* gp_out_puts of a string literal, its length known when compiled (no strlen on the hot
+ * paths). */
+#define GP_OUT_LITERAL(o, literal) gp_out_write((o), "" literal, sizeof(literal) - 1)
 void gp_out_char(gp_out *o, char c);
 /* The shortest decimal that reads back (strtod) to exactly x: 0.06, 1e-7, 123456, 1.5e+300;
  * "NaN", "Infinity" and "-Infinity" for the non-finite (writers that cannot show them
