@@ -57,6 +57,7 @@ static void put_bins(enc *e, const gp_bin_stat *bins, size_t n)
         put_f64(e, bins[i].target);
         put_u64(e, bins[i].count);
         put_f64(e, bins[i].achieved);
+        put_f64(e, bins[i].se);
         put_f64(e, bins[i].z);
     }
 }
@@ -280,7 +281,7 @@ static void get_counts(dec *d, size_t *counts, size_t n)
 /* Reads a bin table into a new array (*bins, *n). Returns 0 or GP_ENOMEM. */
 static int get_bins(dec *d, gp_bin_stat **bins, size_t *n)
 {
-    enum { BIN_BYTES = 48 };
+    enum { BIN_BYTES = 56 };
     *n = get_count(d, BIN_BYTES);
     *bins = calloc(*n ? *n : 1, sizeof **bins);
     if (!*bins)
@@ -292,6 +293,7 @@ static int get_bins(dec *d, gp_bin_stat **bins, size_t *n)
         b->target = get_f64(d);
         b->count = get_size(d);
         b->achieved = get_f64(d);
+        b->se = get_f64(d);
         b->z = get_f64(d);
     }
     return 0;

@@ -12,7 +12,7 @@
 #include "service.h"
 #include "store.h"
 
-/* The compression level of gzip answers. Why this value: see bench/DOWNLOADS.md; level 1
+/* The compression level of gzip answers. Why this value: see bench/SERVICE.md; level 1
  * compresses the text formats to about 45% at some 60 MB/s of one core, where the
  * default 6 gains a few per cent for three times the time. */
 #define GP_DOWNLOAD_GZIP_LEVEL 1

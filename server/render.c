@@ -46,8 +46,7 @@ static int range_match(const char *r, size_t n, const char *mt)
     return 0;
 }
 
-/* The q of the most specific range of `accept` matching mt (0 when none does). */
-static double accept_quality(const char *accept, const char *mt)
+double gp_accept_quality(const char *accept, const char *mt)
 {
     int best_spec = 0;
     double q_best = 0.0;
@@ -95,7 +94,7 @@ int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *rep
         return 0;
     double best = 0.0;
     for (size_t i = 0; i < gp_format_count(); i++) {
-        double q = accept_quality(accept, gp_format_media_type((gp_format)i));
+        double q = gp_accept_quality(accept, gp_format_media_type((gp_format)i));
         if (q > best) { /* ties keep the earlier format: JSON first */
             best = q;
             *out = (gp_format)i;
@@ -151,10 +150,15 @@ int gp_render_accepts_gzip(const gp_request *req)
     return gzip > 0.0;
 }
 
-void gp_render_etag(const gp_stored_result *res, gp_format format, int gzip, char *out)
+void gp_render_etag(const gp_stored_result *res, const gp_spec *spec, gp_format format, int gzip,
+                    char *out)
 {
-    snprintf(out, GP_ETAG_SIZE, "\"%s-%s%s-%s.%d\"", res->version, gp_format_name(format),
-             gzip ? "-gzip" : "", GP_VERSION, GP_RENDER_REVISION);
+    /* only the picture shows the colouring (?color= or the spec's) */
+    const char *color = format != GP_FORMAT_SVG ? ""
+                        : spec->picture_color == GP_PICTURE_COLOR_QUALITY ? "-quality"
+                                                                         : "-radius";
+    snprintf(out, GP_ETAG_SIZE, "\"%s-%s%s%s-%s.%d\"", res->version, gp_format_name(format),
+             color, gzip ? "-gzip" : "", GP_VERSION, GP_RENDER_REVISION);
 }
 
 int gp_render_not_modified(const gp_request *req, const char *etag)

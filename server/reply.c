@@ -8,6 +8,7 @@
 
 #include "grainpack/error.h"
 #include "grainpack/io.h"
+#include "problem.h"
 
 int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, json_t *value)
 {
@@ -21,8 +22,7 @@ int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, js
     }
     json_decref(value);
     if (rc) {
-        reply->status = 500;
-        reply->content_type = "text/plain";
+        gp_problem_out_of_memory(reply);
         return GP_ENOMEM;
     }
     gp_reply_take(reply, status, content_type, out.buf, out.len);
@@ -32,11 +32,13 @@ int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, js
 void gp_reply_take(gp_reply *reply, unsigned status, const char *content_type, char *body,
                    size_t len)
 {
-    free(reply->body);
+    if (!reply->persistent)
+        free(reply->body);
     reply->status = status;
     reply->content_type = content_type;
     reply->body = body;
     reply->len = len;
+    reply->persistent = 0;
 }
 
 int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, const char *text,
@@ -44,7 +46,7 @@ int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, co
 {
     char *copy = malloc(len ? len : 1);
     if (!copy) {
-        reply->status = 500;
+        gp_problem_out_of_memory(reply);
         return GP_ENOMEM;
     }
     memcpy(copy, text, len);
@@ -77,6 +79,7 @@ void gp_reply_free(gp_reply *reply)
 {
     if (reply->stream)
         reply->stream->release(reply->stream);
-    free(reply->body);
+    if (!reply->persistent)
+        free(reply->body);
     memset(reply, 0, sizeof *reply);
 }

@@ -61,26 +61,59 @@ static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp
     gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
     if (rc == 0 && (rc = gp_spec_parse(res->spec_text, res->spec_len, &unlimited, spec, &err)))
         gp_stored_result_free(res);
+    if (rc == GP_ENOMEM) {
+        gp_problem_out_of_memory(reply);
+        return 1;
+    }
     if (rc) {
         gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path,
-                   "the stored result of job %s could not be read (%d)", req->id, rc);
+                   "the stored result of job %s could not be read: %s", req->id,
+                   gp_srv_strerror(rc));
         return 1;
     }
     return 0;
 }
 
+/* Reads ?color=radius|quality, what the picture is coloured by (the spec's choice when
+ * absent). Returns 0 with *color set, or -1 with a 400 in reply. */
+static int picture_color(const gp_request *req, int *color, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, "color");
+    *color = -1;
+    if (!text)
+        return 0;
+    if (strcmp(text, "radius") == 0 || strcmp(text, "quality") == 0) {
+        *color = strcmp(text, "radius") == 0 ? GP_PICTURE_COLOR_RADIUS : GP_PICTURE_COLOR_QUALITY;
+        return 0;
+    }
+    gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+               "color must be radius or quality (F, for a job that balanced), got '%.40s'", text);
+    return -1;
+}
+
 int gp_route_results(gp_request *req, gp_reply *reply)
 {
     gp_format format;
-    if (gp_render_choose_format(req, &format, reply))
+    int color;
+    if (gp_render_choose_format(req, &format, reply) || picture_color(req, &color, reply))
         return GP_ROUTE_DONE;
     gp_stored_result res;
     gp_spec spec;
     if (open_result(req, &res, &spec, reply))
         return GP_ROUTE_DONE;
+    if (color == GP_PICTURE_COLOR_QUALITY && !res.summary.has_balance) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "color=quality colours the grains by F, which only a job that balances has; "
+                   "job %s has no balance stage (color=radius)", req->id);
+        gp_stored_result_free(&res);
+        gp_spec_free(&spec);
+        return GP_ROUTE_DONE;
+    }
+    if (color >= 0)
+        spec.picture_color = (gp_picture_color)color;
     int gzip = gp_format_is_text(format) && gp_render_accepts_gzip(req);
     char etag[GP_ETAG_SIZE];
-    gp_render_etag(&res, format, gzip, etag);
+    gp_render_etag(&res, &spec, format, gzip, etag);
     gp_reply_header_add(reply, "ETag", "%s", etag);
     /* the bytes depend on Accept (the format, without ?f=) and Accept-Encoding */
     gp_reply_header_add(reply, "Vary", "Accept, Accept-Encoding");
@@ -105,8 +138,7 @@ int gp_route_results(gp_request *req, gp_reply *reply)
          * connection would read it as the next status line, so the connection closes */
         reply->close = strcmp(req->method, "HEAD") == 0;
     } else {
-        reply->nheaders = 0;
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory for a download");
+        gp_problem_out_of_memory(reply); /* drops the headers above */
     }
     return GP_ROUTE_DONE;
 }

@@ -40,6 +40,7 @@ def test(c, binary):
             c.check(len(saved) == 1 and open(os.path.join(work, saved[0])).read().startswith("x,y,r,R\n"),
                     f"the download was not saved as job-<id>.csv (decompressed): {os.listdir(work)}")
         for expected in ['"conformsTo"', '"id":"pack2d"', "job at http://", '"status":"successful"',
+                         "<!doctype html>", '"valid":true,"expected_disks":',
                          "x,y,r,R", '"packing_density"', '"timings"', "\n304\n", '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
                          'grainpack_jobs{status="successful"}', "openapi: 3.1.0"]:
