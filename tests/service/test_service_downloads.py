@@ -13,7 +13,9 @@ what the worker stored:
   (checked in the optimised build; under AddressSanitizer, whose quarantine keeps freed
   memory, the figure is only printed);
 - a download paused mid-stream by its client holds no read transaction: a WAL checkpoint
-  then completes.
+  then completes;
+- ?color= recolours the streamed SVG (the command line's bytes for that picture.color) and
+  its ETag names the colouring, so a copy of one colouring is never taken for the other.
 
 Usage: test_service_downloads.py GRAINPACKD GRAINPACK"""
 
@@ -194,6 +196,33 @@ def check_paused_download_holds_no_transaction(c, daemon, client, job):
     c.check(len(first) + len(rest) > 0 and r.status == 200, "the paused download completes")
 
 
+def check_picture_colors(c, client, job, cli_bytes, cli):
+    """The job's spec colours by F (quality): ?color=quality is that very picture and tag,
+    ?color=radius another picture under another tag."""
+    default = client.get(f"/jobs/{job}/results?f=svg")
+    spec = {"inputs": dict(SPEC["inputs"], picture={"color": "radius"})}
+    by_radius = subprocess.run([cli, "run", "-", "--format", "svg"], input=gpd.json.dumps(spec).encode(),
+                               capture_output=True, check=True).stdout
+    c.check(by_radius != cli_bytes["svg"], "colouring by radius gave the same picture as by F")
+    quality = client.get(f"/jobs/{job}/results?f=svg&color=quality")
+    c.check(quality.status == 200 and quality.body == cli_bytes["svg"] and
+            quality.headers.get("etag") == default.headers.get("etag"),
+            f"color=quality: {quality.status}, ETag {quality.headers.get('etag')} for {default.headers.get('etag')}")
+    radius = client.get(f"/jobs/{job}/results?f=svg&color=radius")
+    c.check(radius.status == 200 and radius.body == by_radius,
+            f"color=radius: {radius.status}, {len(radius.body)} bytes, the command line writes {len(by_radius)}")
+    c.check(radius.headers.get("etag") not in (None, default.headers.get("etag")),
+            f"color=radius shares the ETag {radius.headers.get('etag')} of the picture coloured by F")
+    r = client.get(f"/jobs/{job}/results?f=svg&color=radius",
+                   headers={"If-None-Match": default.headers.get("etag", "")})
+    c.check(r.status == 200 and r.body == by_radius, f"color=radius answered {r.status} to the F picture's tag")
+    r = client.get(f"/jobs/{job}/results?f=svg&color=radius",
+                   headers={"If-None-Match": radius.headers.get("etag", "")})
+    c.check(r.status == 304, f"color=radius, its own tag: {r.status}")
+    r = client.get(f"/jobs/{job}/results?f=csv&color=radius")
+    c.check(r.status == 200 and r.body == cli_bytes["csv"], f"color= changed the CSV: {r.status}")
+
+
 def test(c, binary, cli):
     api = gpd.OpenAPI()
     daemon = gpd.Daemon(binary, "--workers", "1")
@@ -209,6 +238,7 @@ def test(c, binary, cli):
         runs = pipeline_runs(client)
         c.check(runs == 1, f"grainpack_pipeline_runs_total is {runs} after one job")
         check_formats(c, api, client, job, cli_bytes)
+        check_picture_colors(c, client, job, cli_bytes, cli)
         st = client.get(f"/jobs/{job}/statistics")
         api.check(c, "GET", "/jobs/{jobId}/statistics", st)
         c.check(st.status == 200 and st.json()["balance"]["sweeps"] == 2, f"statistics: {st}")
