@@ -298,6 +298,7 @@ static void test_a_reader_stops_when_the_job_is_deleted_under_it(void)
     gp_stored_result res;
     CHECK(gp_store_open_result(db, job.id, NULL, &res) == 0);
     gp_result_reader *reader = gp_result_reader_new(res.key);
+    gp_stored_result_free(&res); /* the reader needs the key only */
     gp_disk d[3];
     CHECK(gp_result_reader_read(reader, db, GP_SECTION_DISKS, 32, d, sizeof d) == 0);
     CHECK(memcmp(d, r.packing.disks + 1, sizeof d) == 0);
