@@ -1,20 +1,28 @@
-/* json_values.h - a spec and a result's statistics as jansson values, for the programs
- * built with the library (the service's job documents, the JSON writer). Not installed:
- * no third-party type appears in the public headers; a program outside this tree gets
- * the same text from gp_write_json. */
+/* json_values.h - a spec and a result's statistics as jansson values, and jansson values
+ * written with shortest doubles, for the programs built with the library (the service's
+ * job documents and replies, the JSON writer). Not installed: no third-party type
+ * appears in the public headers; a program outside this tree gets the same text from
+ * gp_write_result in GP_FORMAT_JSON. */
 #ifndef GRAINPACK_CORE_JSON_VALUES_H
 #define GRAINPACK_CORE_JSON_VALUES_H
 
 #include <jansson.h>
 
+#include "grainpack/out.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
 
 /* The statistics of a result as a new JSON object (caller owns the reference; NULL when
  * out of memory): count, densities, radii, the per-bin target-versus-achieved table with
  * chi-square, and how the front went. Timings are not included (they are not
- * reproducible); the caller adds them where it wants them. */
+ * reproducible); the caller adds them where it wants them. Reads only the result's
+ * summary (no per-grain array): a result read back from a store serves as well. */
 json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result);
+
+/* Writes a JSON value compactly, doubles in their shortest round-trip form (jansson's
+ * own dump writes 17 digits, 0.059999999999999998 for 0.06). For small documents: the
+ * statistics object, a job's status. */
+void gp_out_json(gp_out *out, const json_t *value);
 
 /* The spec as JSON inputs, every default made explicit (seed, joint, front, the stages'
  * options, picture): parsed again it gives the same spec. Returns a new reference the

@@ -17,7 +17,8 @@
  *   gp_cells, the statistics), a gp_rt that is not being updated (gp_rt_ring, gp_quality
  *   and gp_laguerre only read it). An object a function takes by non-const pointer is
  *   that call's alone for its duration: a gp_rng (every draw advances it), a gp_out, a
- *   gp_error, a gp_rt under gp_balance or gp_rt_update_moved, any result being filled.
+ *   gp_writer (and the gp_grain_source it reads), a gp_error, a gp_rt under gp_balance
+ *   or gp_rt_update_moved, any result being filled.
  *   gp_progress: report() runs on the thread that runs the stage; *cancel is atomic and
  *   may be raised from any thread.
  *
@@ -30,11 +31,12 @@
  *
  * - Ownership. Each function's comment says what the caller borrows, what it owns and
  *   which gp_..._free releases it; a gp_..._free of a struct zeroes it and accepts a
- *   zeroed one (freeing twice is harmless), gp_rt_free accepts NULL.
+ *   zeroed one (freeing twice is harmless), gp_rt_free and gp_writer_free accept NULL.
  *
- * - Numbers in text. The writers (io.h) format with printf: keep LC_NUMERIC at "C" (the
- *   default of every program that does not call setlocale) while they run, or decimal
- *   commas appear.
+ * - Numbers in text. The writers (io.h) and gp_out's number formats (out.h) write the
+ *   grains' numbers without the C library, whatever the locale; the SVG picture's
+ *   captions and gp_out_printf use printf: keep LC_NUMERIC at "C" (the default of every
+ *   program that does not call setlocale) while they run, or decimal commas appear there.
  *
  * - ABI. Only the functions marked GP_API are exported; the headers show no third-party
  *   type (jansson, CGAL stay inside). Version 0.x: a minor release may change the API;
