@@ -5,7 +5,10 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_2.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -47,15 +50,39 @@ struct gp_rt {
 
 namespace {
 
-// Fills t.rt and t.vertex from the disks; returns 0 or GP_EGEOM (hidden vertex) with err.
-int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
+// Fills t.rt and t.vertex from the disks; returns 0, GP_ECANCELED or GP_EGEOM (hidden
+// vertex) with err. What CGAL's range insertion with info does (the same spatial sort of
+// the same indices, then one insertion after another, each from the last one's face), so
+// the same disks give the same triangulation; but the cancel flag is read between batches.
+int build_into(gp_rt &t, const gp_disk *disks, size_t n, const gp_progress *progress, bool report,
+               gp_error *err)
 {
     t.rt.clear();
-    std::vector<std::pair<Weighted_point, int32_t>> points;
+    std::vector<Point> points;
+    std::vector<std::size_t> order(n);
     points.reserve(n);
-    for (size_t i = 0; i < n; i++)
-        points.emplace_back(weighted(disks[i]), static_cast<int32_t>(i));
-    t.rt.insert(points.begin(), points.end()); // spatially sorted, deterministic order
+    for (size_t i = 0; i < n; i++) {
+        points.emplace_back(disks[i].x, disks[i].y);
+        order[i] = i;
+    }
+    typedef CGAL::Spatial_sort_traits_adapter_2<K, CGAL::Pointer_property_map<Point>::type> Sort_traits;
+    CGAL::spatial_sort(order.begin(), order.end(), Sort_traits(CGAL::make_property_map(points)));
+    Face_handle hint;
+    for (size_t k = 0; k < n; k++) {
+        if (k % GP_RT_INSERT_BATCH == 0 && k > 0 && progress) {
+            if (gp_canceled(progress->cancel))
+                return gp_error_set(err, GP_ECANCELED, NULL,
+                                    "regular triangulation canceled after %zu of %zu disks", k, n);
+            if (report && progress->report)
+                progress->report(progress->ctx, "triangulation", static_cast<double>(k) / static_cast<double>(n));
+        }
+        size_t i = order[k];
+        Vertex_handle v = t.rt.insert(weighted(disks[i]), hint);
+        if (v != Vertex_handle()) {
+            v->info() = static_cast<int32_t>(i);
+            hint = v->face();
+        }
+    }
     t.vertex.assign(n, Vertex_handle());
     for (Rt::Finite_vertices_iterator v = t.rt.finite_vertices_begin();
          v != t.rt.finite_vertices_end(); ++v) {
@@ -163,7 +190,8 @@ move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_u
 
 } // namespace
 
-extern "C" int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err)
+extern "C" int gp_rt_build(const gp_disk *disks, size_t n, const gp_progress *progress, gp_rt **out,
+                           gp_error *err)
 {
     *out = NULL;
     if (n > static_cast<size_t>(INT32_MAX))
@@ -172,7 +200,7 @@ extern "C" int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error
     gp_rt *t = NULL;
     try {
         t = new gp_rt;
-        int rc = build_into(*t, disks, n, err);
+        int rc = build_into(*t, disks, n, progress, true, err);
         if (rc) {
             delete t;
             return rc;
@@ -255,17 +283,22 @@ extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t c
 
 extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks,
                                   const int32_t *ids, size_t nids, gp_rt_update mode,
-                                  gp_rt_update_stats *stats, gp_error *err)
+                                  gp_rt_update_stats *stats, const gp_progress *progress,
+                                  gp_error *err)
 {
     gp_rt_update_stats local = {0, 0, 0, 0};
     gp_rt_update_stats &st = stats ? *stats : local;
     try {
         bool rebuild = mode == GP_RT_UPDATE_REBUILD;
-        for (size_t k = 0; k < nids && !rebuild; k++)
+        for (size_t k = 0; k < nids && !rebuild; k++) {
+            if (k % GP_RT_INSERT_BATCH == GP_RT_INSERT_BATCH - 1 && gp_canceled(gp_progress_cancel(progress)))
+                return gp_error_set(err, GP_ECANCELED, NULL,
+                                    "triangulation update canceled after %zu of %zu moves", k, nids);
             rebuild = move_vertex(*rt, ids[k], weighted(disks[ids[k]]), st) == NEEDS_REBUILD;
+        }
         if (rebuild) {
             st.rebuilds++;
-            return build_into(*rt, disks, ndisks, err);
+            return build_into(*rt, disks, ndisks, progress, false, err);
         }
         return 0;
     } catch (const std::bad_alloc &) {
