@@ -2,8 +2,11 @@
  * a job past --max-job-seconds, a stop of the daemon), in each stage: one full run is
  * timed stage by stage, then the same job is run again and again with the flag raised at
  * evenly spread moments, and the time from the flag to the pipeline's return is measured.
- * Prints markdown. Not a test: wall-clock figures, read with the load average.
+ * Prints markdown. Not a test: wall-clock figures, read with the load average, and the
+ * CPU time the job's thread spent from the flag to its return (what the wall-clock time
+ * would be on an idle core).
  * Usage: grainpack_cancel_bench [--grains N] [--runs K] [--sweeps S] */
+#define _GNU_SOURCE /* getloadavg */
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,9 +54,17 @@ typedef struct run {
     gp_cancel_flag cancel;
     watch w;
     int rc;
-    double ended;
+    double ended, ended_cpu;
     size_t disks;
 } run;
+
+/* The CPU seconds a thread has used so far (from any thread). */
+static double thread_cpu(clockid_t clock)
+{
+    struct timespec ts;
+    clock_gettime(clock, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
 
 static void *run_main(void *arg)
 {
@@ -63,11 +74,19 @@ static void *run_main(void *arg)
     gp_error err;
     r->rc = gp_pipeline_run(r->spec, 0, &progress, &result, &err);
     r->ended = now();
+    r->ended_cpu = thread_cpu(CLOCK_THREAD_CPUTIME_ID);
     if (r->rc == 0) {
         r->disks = result.packing.count;
         gp_result_free(&result);
     }
     return NULL;
+}
+
+static double load_now(void)
+{
+    double load = -1.0;
+    getloadavg(&load, 1);
+    return load;
 }
 
 static int compare(const void *a, const void *b)
@@ -127,9 +146,10 @@ int main(int argc, char **argv)
     printf(".\n\n");
 
     /* the flag raised at k/(runs+1) of the full run, k = 1..runs */
-    double latency[MAX_RUNS];
+    double latency[MAX_RUNS], cpu[MAX_RUNS];
     const char *stage[MAX_RUNS];
-    printf("| flag raised at | stage | stopped after |\n|---|---|---|\n");
+    printf("| flag raised at | stage | stopped after | CPU time of the job's thread meanwhile |\n"
+           "|---|---|---|---|\n");
     for (int k = 0; k < runs; k++) {
         run *r = calloc(1, sizeof *r);
         r->spec = &spec;
@@ -141,23 +161,30 @@ int main(int argc, char **argv)
         struct timespec ts = {(time_t)at, (long)((at - (double)(time_t)at) * 1e9)};
         nanosleep(&ts, NULL);
         stage[k] = __atomic_load_n(&r->w.stage, __ATOMIC_RELAXED);
-        double raised = now();
+        clockid_t clock;
+        pthread_getcpuclockid(thread, &clock);
+        double raised = now(), raised_cpu = thread_cpu(clock);
         atomic_store(&r->cancel, 1);
         pthread_join(thread, NULL);
         latency[k] = r->rc == GP_ECANCELED ? r->ended - raised : -1.0;
-        printf("| %.2f s | %s | %s%.1f ms |\n", raised - start, stage[k],
-               r->rc == GP_ECANCELED ? "" : "(finished first) ", 1e3 * (r->ended - raised));
+        cpu[k] = r->ended_cpu - raised_cpu;
+        printf("| %.2f s | %s | %s%.1f ms | %.1f ms |\n", raised - start, stage[k],
+               r->rc == GP_ECANCELED ? "" : "(finished first) ", 1e3 * (r->ended - raised), 1e3 * cpu[k]);
         free(r);
     }
-    double sorted[MAX_RUNS];
+    double sorted[MAX_RUNS], sorted_cpu[MAX_RUNS];
     int n = 0;
     for (int k = 0; k < runs; k++)
-        if (latency[k] >= 0)
+        if (latency[k] >= 0) {
+            sorted_cpu[n] = cpu[k];
             sorted[n++] = latency[k];
+        }
     qsort(sorted, (size_t)n, sizeof *sorted, compare);
+    qsort(sorted_cpu, (size_t)n, sizeof *sorted_cpu, compare);
     if (n)
-        printf("\n%d cancellations: median %.1f ms, max %.1f ms.\n", n, 1e3 * sorted[n / 2],
-               1e3 * sorted[n - 1]);
+        printf("\n%d cancellations: median %.1f ms, max %.1f ms (CPU: median %.1f ms, max %.1f ms); "
+               "load average %.2f at the end.\n", n, 1e3 * sorted[n / 2], 1e3 * sorted[n - 1],
+               1e3 * sorted_cpu[n / 2], 1e3 * sorted_cpu[n - 1], load_now());
     gp_spec_free(&spec);
     return 0;
 }

@@ -287,11 +287,15 @@ static void test_a_raised_flag_stops_builds_updates_and_measures(void)
     rt = (gp_rt *)&stop; /* must come back NULL */
     CHECK(gp_rt_build(d, n, &stopping, &rt, &err) == GP_ECANCELED && rt == NULL);
     CHECK(stop.calls == 1 && strstr(err.message, "canceled after 8192 of 10000") != NULL);
-    /* raised before, an update of more than a batch of moves stops, and so does a rebuild */
-    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    /* raised before, the build stops in its spatial sort (10^4 disks: over 10^5
+     * comparisons, a check every 2^16); an update of more than a batch of moves stops,
+     * and so does a rebuild */
     gp_cancel_flag raised;
     atomic_init(&raised, 1);
     gp_progress canceled = {NULL, NULL, &raised};
+    CHECK(gp_rt_build(d, n, &canceled, &rt, &err) == GP_ECANCELED && rt == NULL);
+    CHECK(strstr(err.message, "while sorting") != NULL);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     int32_t *ids = malloc(N * sizeof *ids);
     for (size_t i = 0; i < n; i++)
         ids[i] = (int32_t)i;
