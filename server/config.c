@@ -20,6 +20,10 @@
 /* A job at the default disk cap packs in seconds; ten minutes leaves room for slow
  * stages and a loaded machine, and still frees a worker held by a runaway job. */
 #define DEFAULT_MAX_JOB_SECONDS 600.0
+/* A job is run at most this many times: one that was running each time the daemon died
+ * (a crash, a kill, a stop it did not answer) is failed instead of claimed at every
+ * start. Three lets a job survive two unrelated crashes or kills of the node. */
+#define DEFAULT_MAX_JOB_ATTEMPTS 3
 /* Enough for a script that submits a parameter sweep, far below the queue's size, so
  * that one user cannot fill the queue for everyone. */
 #define DEFAULT_MAX_JOBS_PER_KEY ((size_t)100)
@@ -70,6 +74,9 @@ static const option options[] = {
     {"--max-job-seconds", "GRAINPACKD_MAX_JOB_SECONDS",
      "seconds a job may run before it is stopped and failed (default 600; 0: no limit)",
      SECONDS(max_job_seconds, 0, 10000000)},
+    {"--max-job-attempts", "GRAINPACKD_MAX_JOB_ATTEMPTS",
+     "times a job is started before a job the daemon died running is failed (default 3)",
+     INT(max_job_attempts, 1, 1000)},
     {"--max-jobs-per-key", "GRAINPACKD_MAX_JOBS_PER_KEY",
      "accepted and running jobs one API key may have before 429 (default 100; 0: no limit)",
      SIZE(max_jobs_per_key, 0, (size_t)1 << 30)},
@@ -177,6 +184,7 @@ int gp_config_load(gp_config *cfg, int argc, char **argv, FILE *out, FILE *err)
     cfg->max_disks = DEFAULT_MAX_DISKS;
     cfg->max_bins = DEFAULT_MAX_BINS;
     cfg->max_job_seconds = DEFAULT_MAX_JOB_SECONDS;
+    cfg->max_job_attempts = DEFAULT_MAX_JOB_ATTEMPTS;
     cfg->max_jobs_per_key = DEFAULT_MAX_JOBS_PER_KEY;
     cfg->max_wait = DEFAULT_MAX_WAIT;
     cfg->max_header_bytes = DEFAULT_MAX_HEADER_BYTES;

@@ -20,6 +20,9 @@ typedef struct gp_config {
     size_t max_bins;          /* --max-bins / GRAINPACKD_MAX_BINS histogram bins, default 10000 */
     double max_job_seconds;   /* --max-job-seconds / GRAINPACKD_MAX_JOB_SECONDS of running per
                                  job, default 600; 0: no limit */
+    int max_job_attempts;     /* --max-job-attempts / GRAINPACKD_MAX_JOB_ATTEMPTS: times a job is
+                                 started; one the daemon died running that often is failed at
+                                 the next start instead of queued again; default 3 */
     size_t max_jobs_per_key;  /* --max-jobs-per-key / GRAINPACKD_MAX_JOBS_PER_KEY accepted and
                                  running jobs of one key, default 100; 0: no limit */
     int max_wait;             /* --max-wait / GRAINPACKD_MAX_WAIT seconds of long-poll, default 60 */

@@ -122,6 +122,7 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     g.queue_depth = atomic_load(&svc->queued);
     g.workers = svc->cfg->workers;
     g.workers_busy = gp_pool_busy(svc->pool);
+    g.workers_abandoned = gp_pool_abandoned(svc->pool);
     size_t len;
     char *text = gp_metrics_render(svc->metrics, &g, &len);
     if (!text) {

@@ -59,11 +59,16 @@ typedef struct gp_job {
 typedef struct gp_store gp_store;
 typedef struct gp_db gp_db;
 
-/* Opens (creating if needed) the database at path, migrates it to the current schema and
- * queues again the jobs a crash left running (their count in *requeued, may be NULL).
+/* Opens (creating if needed) the database at path and migrates it to the current schema.
  * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why. The caller owns *out
  * (gp_store_close). */
-int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size);
+int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size);
+
+/* At start, the jobs a previous run left running (it died: a crash, a kill, a stop that
+ * gave up on a worker): those started max_attempts times or more (their claims; a clean
+ * stop gives its claim back) fail with a message that says why (*given_up counts them),
+ * the others are queued again (*requeued). Returns 0 or a write failure. */
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up);
 
 /* Closes every connection. All gp_db must have been released. */
 void gp_store_close(gp_store *store);

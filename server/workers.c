@@ -1,5 +1,6 @@
-/* workers.c - worker threads: claim a job, run the pipeline, store what came of it; and
- * the watchdog that stops a job past --max-job-seconds. */
+/* workers.c - worker threads: claim a job, run the pipeline, store what came of it; the
+ * watchdog that stops a job past --max-job-seconds and replaces a worker that does not
+ * stop when told; the bounded stop. */
 /* SCHED_IDLE (Linux) needs _GNU_SOURCE; the rest of the project keeps _DEFAULT_SOURCE. */
 #define _GNU_SOURCE
 #include "workers.h"
@@ -35,6 +36,27 @@
  * cancel-check interval. */
 #define WATCHDOG_SECONDS 0.1
 
+/* A worker told to stop (dismissed, timed out) that still runs this many seconds later
+ * is given up on: another thread takes its place, and it frees itself if it ever returns.
+ * Every stage reads its flag within milliseconds (bench/CANCEL.md: under 0.1 s of CPU for
+ * a million disks, freeing included), so only a stage that ignores it, or a store write
+ * held up (sqlite waits up to 30 s for another process's write lock), comes this far. */
+#define ABANDON_SECONDS 2.0
+
+/* At most this many workers given up on, per worker of the pool, still run: beyond, the
+ * pool stops replacing them rather than start threads without end. */
+#define ABANDONED_PER_WORKER 1
+
+/* How long a failed start waits for the workers it started (idle: they return at once). */
+#define STARTUP_STOP_SECONDS 10.0
+
+/* A test-only fault (never set in production): the environment variable
+ * GRAINPACKD_TEST_STALL_SECONDS makes the first progress report of each job sleep that
+ * long without reading its cancel flag, as a stage that ignores the flag would. The
+ * service tests use it to check that the pool replaces such a worker and that a stop
+ * stays bounded. */
+#define TEST_STALL_ENV "GRAINPACKD_TEST_STALL_SECONDS"
+
 /* When the outcome of a job cannot be stored (disk full, database not writable), the worker
  * keeps it and tries again after this many seconds, doubling up to the maximum: a
  * result is never dropped while the daemon runs, and a stop leaves the job running in
@@ -52,6 +74,11 @@ typedef struct worker {
     char job_id[GP_JOB_ID_SIZE]; /* the job it runs, "" when idle; guarded by pool->lock */
     double deadline;             /* monotonic seconds it must end by, 0: none; pool->lock */
     double started;              /* monotonic seconds it started, for the failure message */
+    double canceled_at;          /* monotonic seconds its flag was raised, 0: not; pool->lock */
+    int abandoned;               /* given up on (see ABANDON_SECONDS); pool->lock */
+    int storing;                 /* its pipeline returned, the outcome is being stored: no
+                                    time limit, no giving up any more; pool->lock */
+    int stalled;                 /* the test fault slept already for this job */
     gp_db *db;                   /* its own connection, for the thread's lifetime */
     double last_write;           /* progress throttling */
     int last_percent;
@@ -63,18 +90,31 @@ struct gp_pool {
     pthread_cond_t wake;  /* idle workers wait on it */
     pthread_cond_t watch; /* the watchdog waits on it */
     pthread_cond_t retry; /* a worker waiting to store an outcome again waits on it */
+    pthread_cond_t gone;  /* a worker thread returned */
     int stopping;
     unsigned pending; /* notifications not yet taken by an idle worker */
     atomic_int busy;
     int n;
-    worker *workers;
+    worker **workers;  /* the n slots; a slot's worker is replaced when given up on */
+    int alive;         /* threads not yet returned: workers (given-up ones included) and
+                          the watchdog; lock */
+    atomic_int abandoned; /* given-up worker threads still running */
+    double stall;      /* the test fault's seconds (TEST_STALL_ENV), 0: none */
     pthread_t watchdog;
     int has_watchdog;
+    gp_db *watchdog_db; /* the watchdog's connection, to fail a job given up on */
 };
 
 static void report_progress(void *ctx, const char *stage, double fraction)
 {
     worker *w = ctx;
+    if (w->pool->stall > 0 && !w->stalled) {
+        w->stalled = 1;
+        struct timespec ts = {(time_t)w->pool->stall,
+                              (long)((w->pool->stall - (double)(time_t)w->pool->stall) * 1e9)};
+        while (nanosleep(&ts, &ts) != 0)
+            ;
+    }
     int percent = (int)(fraction * 100.0);
     percent = percent < 0 ? 0 : (percent > 99 ? 99 : percent); /* 100 means stored */
     if (percent <= w->last_percent)
@@ -100,6 +140,9 @@ static void set_current(worker *w, const char *id)
     atomic_store(&w->cancel, pool->stopping ? CANCEL_SHUTDOWN : CANCEL_NONE);
     snprintf(w->job_id, sizeof w->job_id, "%s", id);
     w->started = gp_monotonic_seconds();
+    w->canceled_at = pool->stopping ? w->started : 0;
+    w->stalled = 0;
+    w->storing = 0;
     w->deadline = id[0] && limit > 0 ? w->started + limit : 0;
     pthread_cond_signal(&pool->watch);
     pthread_mutex_unlock(&pool->lock);
@@ -118,7 +161,97 @@ static struct timespec realtime_in(double seconds)
     return ts;
 }
 
-/* Raises CANCEL_TIMEOUT on every job past its deadline; sleeps until the next one. */
+/* Raises w's cancel flag (pool->lock held). A timeout does not replace a dismissal or a
+ * stop that came first; the first raise starts the ABANDON_SECONDS clock. */
+static void raise_cancel(worker *w, int why, double now)
+{
+    if (why == CANCEL_TIMEOUT) {
+        int none = CANCEL_NONE;
+        atomic_compare_exchange_strong(&w->cancel, &none, CANCEL_TIMEOUT);
+    } else {
+        atomic_store(&w->cancel, why);
+    }
+    if (w->canceled_at <= 0)
+        w->canceled_at = now;
+}
+
+static void *worker_main(void *arg);
+
+/* Starts a worker thread in slot i (pool->lock held). Returns 0 or GP_ENOMEM. */
+static int start_worker(gp_pool *pool, int i)
+{
+    worker *w = calloc(1, sizeof *w);
+    if (!w)
+        return GP_ENOMEM;
+    w->pool = pool;
+    atomic_init(&w->cancel, CANCEL_NONE);
+    if (pthread_create(&w->thread, NULL, worker_main, w)) {
+        free(w);
+        return GP_ENOMEM;
+    }
+    pool->workers[i] = w;
+    pool->alive++;
+    return 0;
+}
+
+/* A job whose worker was given up on. */
+typedef struct given_up {
+    char id[GP_JOB_ID_SIZE];
+    int why;
+    double ran;
+} given_up;
+
+/* Gives up on the worker in slot i, told to stop ABANDON_SECONDS ago and still running,
+ * and starts another in its place (pool->lock held). Returns 1 when it did, with the job
+ * in *job; 0 when no thread can be started (the worker stays in its slot). */
+static int abandon(gp_pool *pool, int i, double now, given_up *job)
+{
+    worker *w = pool->workers[i];
+    if (atomic_load(&pool->abandoned) >= ABANDONED_PER_WORKER * pool->n || start_worker(pool, i)) {
+        pool->workers[i] = w;
+        return 0;
+    }
+    w->abandoned = 1;
+    pthread_detach(w->thread);
+    atomic_fetch_add(&pool->abandoned, 1);
+    atomic_fetch_sub(&pool->busy, 1);
+    snprintf(job->id, sizeof job->id, "%s", w->job_id);
+    job->why = atomic_load(&w->cancel);
+    job->ran = now - w->started;
+    return 1;
+}
+
+/* Records that a job's worker was given up on: a timed-out job fails (a dismissed one
+ * already is), its waiters are woken. Called without pool->lock. */
+static void record_given_up(gp_pool *pool, const given_up *job)
+{
+    gp_service *svc = pool->svc;
+    gp_log("job %s: its worker did not stop within %.0f s of being told to (%s); another "
+           "worker takes its place, and the job's result is dropped if it ever comes",
+           job->id, ABANDON_SECONDS,
+           job->why == CANCEL_TIMEOUT ? "time limit" : job->why == CANCEL_DISMISSED ? "dismissed" : "stop");
+    gp_metrics_outcome(svc->metrics, "abandoned");
+    if (job->why == CANCEL_TIMEOUT) {
+        char message[256];
+        snprintf(message, sizeof message,
+                 "stopped after %.1f s: a job may run at most %g s (--max-job-seconds); "
+                 "submit a smaller job, or ask the administrator for a longer limit",
+                 job->ran, svc->cfg->max_job_seconds);
+        if (!pool->watchdog_db)
+            pool->watchdog_db = gp_store_acquire(svc->store, 0);
+        if (!pool->watchdog_db || gp_store_fail(pool->watchdog_db, job->id, "time limit", message) < 0)
+            gp_log("job %s: cannot record its failure now; it is queued again at the next start",
+                   job->id);
+        if (gp_store_broken(pool->watchdog_db)) {
+            gp_store_release(svc->store, pool->watchdog_db);
+            pool->watchdog_db = NULL;
+        }
+    }
+    gp_waiters_wake(svc->waiters, job->id);
+}
+
+/* Raises CANCEL_TIMEOUT on every job past its deadline, gives up on workers that do not
+ * stop; sleeps until the next deadline. */
 static void *watchdog_main(void *arg)
 {
     gp_pool *pool = arg;
@@ -126,20 +259,33 @@ static void *watchdog_main(void *arg)
     while (!pool->stopping) {
         double now = gp_monotonic_seconds(), next = now + 1.0;
         for (int i = 0; i < pool->n; i++) {
-            worker *w = &pool->workers[i];
-            if (!w->job_id[0] || w->deadline <= 0)
+            worker *w = pool->workers[i];
+            if (!w->job_id[0] || w->storing)
                 continue;
-            if (now >= w->deadline) {
-                int none = CANCEL_NONE; /* a dismissal or a stop that came first stays */
-                atomic_compare_exchange_strong(&w->cancel, &none, CANCEL_TIMEOUT);
-            } else if (w->deadline < next) {
+            if (w->deadline > 0 && now >= w->deadline)
+                raise_cancel(w, CANCEL_TIMEOUT, now);
+            else if (w->deadline > 0 && w->deadline < next)
                 next = w->deadline;
+            given_up job;
+            if (w->canceled_at > 0 && now - w->canceled_at >= ABANDON_SECONDS &&
+                abandon(pool, i, now, &job)) {
+                pthread_mutex_unlock(&pool->lock);
+                record_given_up(pool, &job);
+                pthread_mutex_lock(&pool->lock);
+                if (pool->stopping)
+                    break;
             }
         }
         double wait = next - now;
         struct timespec ts = realtime_in(wait < WATCHDOG_SECONDS ? wait : WATCHDOG_SECONDS);
         pthread_cond_timedwait(&pool->watch, &pool->lock, &ts);
     }
+    pthread_mutex_unlock(&pool->lock);
+    gp_store_release(pool->svc->store, pool->watchdog_db);
+    pool->watchdog_db = NULL;
+    pthread_mutex_lock(&pool->lock);
+    pool->alive--;
+    pthread_cond_broadcast(&pool->gone);
     pthread_mutex_unlock(&pool->lock);
     return NULL;
 }
@@ -268,11 +414,21 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
         gp_progress progress = {report_progress, w, &w->cancel};
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
     }
-    conclude(w, id, rc, &result, &err);
+    pthread_mutex_lock(&w->pool->lock);
+    int abandoned = w->abandoned;
+    w->storing = 1;
+    pthread_mutex_unlock(&w->pool->lock);
+    if (abandoned)
+        gp_log("job %s: the worker given up on returned after %.1f s; its outcome is dropped", id,
+               gp_monotonic_seconds() - w->started);
+    else
+        conclude(w, id, rc, &result, &err);
     gp_result_free(&result);
     gp_spec_free(&spec);
-    atomic_fetch_sub(&w->pool->busy, 1);
-    set_current(w, "");
+    if (!abandoned) {
+        atomic_fetch_sub(&w->pool->busy, 1);
+        set_current(w, "");
+    }
 }
 
 /* Waits for a notification, a stop or the recheck interval. Returns 0 when stopping. */
@@ -292,6 +448,25 @@ static int wait_for_work(gp_pool *pool)
     return go_on;
 }
 
+/* A worker thread's end: its connection back, the pool told; a worker given up on
+ * frees itself (its slot has another). */
+static void *worker_exit(worker *w)
+{
+    gp_pool *pool = w->pool;
+    gp_store_release(pool->svc->store, w->db);
+    w->db = NULL;
+    pthread_mutex_lock(&pool->lock);
+    int abandoned = w->abandoned;
+    if (abandoned)
+        atomic_fetch_sub(&pool->abandoned, 1);
+    pool->alive--;
+    pthread_cond_broadcast(&pool->gone);
+    pthread_mutex_unlock(&pool->lock);
+    if (abandoned)
+        free(w);
+    return NULL;
+}
+
 static void *worker_main(void *arg)
 {
     worker *w = arg;
@@ -307,7 +482,7 @@ static void *worker_main(void *arg)
         gp_log("worker: cannot lower its priority; requests may wait behind packing");
     for (;;) {
         pthread_mutex_lock(&pool->lock);
-        int stopping = pool->stopping;
+        int stopping = pool->stopping || w->abandoned;
         pthread_mutex_unlock(&pool->lock);
         if (stopping)
             break;
@@ -333,7 +508,7 @@ static void *worker_main(void *arg)
         if (!wait_for_work(pool))
             break;
     }
-    return NULL;
+    return worker_exit(w);
 }
 
 int gp_pool_start(gp_service *svc, gp_pool **out)
@@ -345,28 +520,30 @@ int gp_pool_start(gp_service *svc, gp_pool **out)
         return GP_ENOMEM;
     }
     pool->svc = svc;
+    const char *stall = getenv(TEST_STALL_ENV);
+    pool->stall = stall ? atof(stall) : 0.0;
     pthread_mutex_init(&pool->lock, NULL);
     pthread_cond_init(&pool->wake, NULL);
     pthread_cond_init(&pool->watch, NULL);
     pthread_cond_init(&pool->retry, NULL);
-    for (int i = 0; i < n; i++) {
-        worker *w = &pool->workers[i];
-        w->pool = pool;
-        atomic_init(&w->cancel, CANCEL_NONE);
-        if (pthread_create(&w->thread, NULL, worker_main, w)) {
-            pool->n = i;
-            gp_pool_stop(pool);
+    pthread_cond_init(&pool->gone, NULL);
+    atomic_init(&pool->abandoned, 0);
+    pthread_mutex_lock(&pool->lock);
+    int rc = 0;
+    for (int i = 0; i < n && rc == 0; i++)
+        if ((rc = start_worker(pool, i)) == 0)
+            pool->n = i + 1;
+    if (rc == 0 && pthread_create(&pool->watchdog, NULL, watchdog_main, pool))
+        rc = GP_ENOMEM;
+    pool->has_watchdog = rc == 0;
+    pool->alive += pool->has_watchdog;
+    pthread_mutex_unlock(&pool->lock);
+    if (rc) {
+        /* the workers started are idle: they return at once */
+        if (gp_pool_stop(pool, STARTUP_STOP_SECONDS) == 0)
             gp_pool_free(pool);
-            return GP_ENOMEM;
-        }
-        pool->n = i + 1;
+        return rc;
     }
-    if (pthread_create(&pool->watchdog, NULL, watchdog_main, pool)) {
-        gp_pool_stop(pool);
-        gp_pool_free(pool);
-        return GP_ENOMEM;
-    }
-    pool->has_watchdog = 1;
     *out = pool;
     return 0;
 }
@@ -387,10 +564,11 @@ int gp_pool_cancel(gp_pool *pool, const char *job_id)
     if (!pool)
         return 0;
     pthread_mutex_lock(&pool->lock);
+    double now = gp_monotonic_seconds();
     for (int i = 0; i < pool->n; i++) {
-        worker *w = &pool->workers[i];
+        worker *w = pool->workers[i];
         if (strcmp(w->job_id, job_id) == 0) {
-            atomic_store(&w->cancel, CANCEL_DISMISSED);
+            raise_cancel(w, CANCEL_DISMISSED, now);
             found = 1;
         }
     }
@@ -403,31 +581,49 @@ int gp_pool_busy(gp_pool *pool)
     return pool ? atomic_load(&pool->busy) : 0;
 }
 
-void gp_pool_stop(gp_pool *pool)
+int gp_pool_abandoned(gp_pool *pool)
+{
+    return pool ? atomic_load(&pool->abandoned) : 0;
+}
+
+int gp_pool_stop(gp_pool *pool, double seconds)
 {
     if (!pool)
-        return;
+        return 0;
     pthread_mutex_lock(&pool->lock);
     pool->stopping = 1;
+    double now = gp_monotonic_seconds();
     for (int i = 0; i < pool->n; i++)
-        if (pool->workers[i].job_id[0])
-            atomic_store(&pool->workers[i].cancel, CANCEL_SHUTDOWN);
+        if (pool->workers[i]->job_id[0])
+            raise_cancel(pool->workers[i], CANCEL_SHUTDOWN, now);
     pthread_cond_broadcast(&pool->wake);
     pthread_cond_signal(&pool->watch);
     pthread_cond_broadcast(&pool->retry);
+    /* every thread returns within milliseconds of its flag, unless a stage ignores it or
+     * a store write is held up (the watchdog's too): then the stop gives up after
+     * `seconds` */
+    double deadline = now + seconds;
+    while (pool->alive > atomic_load(&pool->abandoned) && gp_monotonic_seconds() < deadline) {
+        struct timespec ts = realtime_in(deadline - gp_monotonic_seconds());
+        pthread_cond_timedwait(&pool->gone, &pool->lock, &ts);
+    }
+    int running = pool->alive; /* those given up on are not waited for: their jobs are done */
     pthread_mutex_unlock(&pool->lock);
+    if (running)
+        return running;
     if (pool->has_watchdog) {
         pthread_join(pool->watchdog, NULL);
         pool->has_watchdog = 0;
     }
     for (int i = 0; i < pool->n; i++) {
-        pthread_join(pool->workers[i].thread, NULL);
-        gp_store_release(pool->svc->store, pool->workers[i].db);
-        pool->workers[i].db = NULL;
+        pthread_join(pool->workers[i]->thread, NULL);
+        free(pool->workers[i]);
+        pool->workers[i] = NULL;
     }
     pthread_mutex_lock(&pool->lock);
     pool->n = 0;
     pthread_mutex_unlock(&pool->lock);
+    return 0;
 }
 
 void gp_pool_free(gp_pool *pool)
@@ -437,6 +633,7 @@ void gp_pool_free(gp_pool *pool)
     pthread_cond_destroy(&pool->wake);
     pthread_cond_destroy(&pool->watch);
     pthread_cond_destroy(&pool->retry);
+    pthread_cond_destroy(&pool->gone);
     pthread_mutex_destroy(&pool->lock);
     free(pool->workers);
     free(pool);

@@ -42,7 +42,7 @@ static gp_db *open_fresh(gp_store **store)
 {
     remove_database();
     char why[256];
-    if (gp_store_open(db_path, store, NULL, why, sizeof why) != 0) {
+    if (gp_store_open(db_path, store, why, sizeof why) != 0) {
         fprintf(stderr, "%s\n", why);
         abort();
     }
@@ -66,7 +66,7 @@ static void test_a_version_1_database_migrates_and_keeps_its_jobs(void)
 
     gp_store *store;
     char why[256];
-    CHECK(gp_store_open(db_path, &store, NULL, why, sizeof why) == 0);
+    CHECK(gp_store_open(db_path, &store, why, sizeof why) == 0);
     gp_db *db = gp_store_acquire(store, 1);
     gp_job job;
     CHECK(gp_store_get_job(db, "old-job", NULL, &job) == 0);
