@@ -161,6 +161,17 @@ static struct timespec realtime_in(double seconds)
     return ts;
 }
 
+#define TIMEOUT_MESSAGE_SIZE 256
+
+/* The message of a job stopped by --max-job-seconds after `ran` seconds. */
+static void timeout_message(char out[TIMEOUT_MESSAGE_SIZE], double ran, double limit)
+{
+    snprintf(out, TIMEOUT_MESSAGE_SIZE,
+             "stopped after %.1f s: a job may run at most %g s (--max-job-seconds); "
+             "submit a smaller job, or ask the administrator for a longer limit",
+             ran, limit);
+}
+
 /* Raises w's cancel flag (pool->lock held). A timeout does not replace a dismissal or a
  * stop that came first; the first raise starts the ABANDON_SECONDS clock. */
 static void raise_cancel(worker *w, int why, double now)
@@ -232,11 +243,8 @@ static void record_given_up(gp_pool *pool, const given_up *job)
            job->why == CANCEL_TIMEOUT ? "time limit" : job->why == CANCEL_DISMISSED ? "dismissed" : "stop");
     gp_metrics_outcome(svc->metrics, "abandoned");
     if (job->why == CANCEL_TIMEOUT) {
-        char message[256];
-        snprintf(message, sizeof message,
-                 "stopped after %.1f s: a job may run at most %g s (--max-job-seconds); "
-                 "submit a smaller job, or ask the administrator for a longer limit",
-                 job->ran, svc->cfg->max_job_seconds);
+        char message[TIMEOUT_MESSAGE_SIZE];
+        timeout_message(message, job->ran, svc->cfg->max_job_seconds);
         if (!pool->watchdog_db)
             pool->watchdog_db = gp_store_acquire(svc->store, 0);
         if (!pool->watchdog_db || gp_store_fail(pool->watchdog_db, job->id, "time limit", message) < 0)
@@ -364,12 +372,8 @@ static void conclude(worker *w, const char *id, int rc, const gp_result *result,
             gp_log("job %s finished after it was dismissed: result discarded", id);
         }
     } else if (rc == GP_ECANCELED && flag == CANCEL_TIMEOUT) {
-        char message[200];
-        double limit = svc->cfg->max_job_seconds;
-        snprintf(message, sizeof message,
-                 "stopped after %.1f s: a job may run at most %g s (--max-job-seconds); "
-                 "submit a smaller job, or ask the administrator for a longer limit",
-                 gp_monotonic_seconds() - w->started, limit);
+        char message[TIMEOUT_MESSAGE_SIZE];
+        timeout_message(message, gp_monotonic_seconds() - w->started, svc->cfg->max_job_seconds);
         persist(w, id, OUTCOME_FAIL, NULL, "time limit", message);
         gp_metrics_outcome(svc->metrics, "timed_out");
         gp_log("job %s failed: %s", id, message);
