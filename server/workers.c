@@ -51,10 +51,10 @@
 #define STARTUP_STOP_SECONDS 10.0
 
 /* A test-only fault (never set in production): the environment variable
- * GRAINPACKD_TEST_STALL_SECONDS makes the first progress report of each job sleep that
- * long without reading its cancel flag, as a stage that ignores the flag would. The
- * service tests use it to check that the pool replaces such a worker and that a stop
- * stays bounded. */
+ * GRAINPACKD_TEST_STALL_SECONDS makes the first progress report of the first job the
+ * daemon runs sleep that long without reading its cancel flag, as a stage that ignores
+ * the flag would. The service tests use it to check that the pool replaces such a worker,
+ * that a stop stays bounded, and what a restart does with the job. */
 #define TEST_STALL_ENV "GRAINPACKD_TEST_STALL_SECONDS"
 
 /* When the outcome of a job cannot be stored (disk full, database not writable), the worker
@@ -78,7 +78,6 @@ typedef struct worker {
     int abandoned;               /* given up on (see ABANDON_SECONDS); pool->lock */
     int storing;                 /* its pipeline returned, the outcome is being stored: no
                                     time limit, no giving up any more; pool->lock */
-    int stalled;                 /* the test fault slept already for this job */
     gp_db *db;                   /* its own connection, for the thread's lifetime */
     double last_write;           /* progress throttling */
     int last_percent;
@@ -100,6 +99,7 @@ struct gp_pool {
                           the watchdog; lock */
     atomic_int abandoned; /* given-up worker threads still running */
     double stall;      /* the test fault's seconds (TEST_STALL_ENV), 0: none */
+    atomic_int stalled; /* the test fault struck already */
     pthread_t watchdog;
     int has_watchdog;
     gp_db *watchdog_db; /* the watchdog's connection, to fail a job given up on */
@@ -108,8 +108,7 @@ struct gp_pool {
 static void report_progress(void *ctx, const char *stage, double fraction)
 {
     worker *w = ctx;
-    if (w->pool->stall > 0 && !w->stalled) {
-        w->stalled = 1;
+    if (w->pool->stall > 0 && atomic_exchange(&w->pool->stalled, 1) == 0) {
         struct timespec ts = {(time_t)w->pool->stall,
                               (long)((w->pool->stall - (double)(time_t)w->pool->stall) * 1e9)};
         while (nanosleep(&ts, &ts) != 0)
@@ -141,7 +140,6 @@ static void set_current(worker *w, const char *id)
     snprintf(w->job_id, sizeof w->job_id, "%s", id);
     w->started = gp_monotonic_seconds();
     w->canceled_at = pool->stopping ? w->started : 0;
-    w->stalled = 0;
     w->storing = 0;
     w->deadline = id[0] && limit > 0 ? w->started + limit : 0;
     pthread_cond_signal(&pool->watch);
@@ -392,7 +390,6 @@ static void conclude(worker *w, const char *id, int rc, const gp_result *result,
         gp_log("job %s failed: %s%s", id, err->message,
                st == GP_SRV_ESTATE ? " (it had been dismissed)" : "");
     }
-    gp_waiters_wake(svc->waiters, id);
 }
 
 static void run_job(worker *w, const char *id, const char *spec_text, size_t spec_len)
@@ -432,6 +429,8 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     if (!abandoned) {
         atomic_fetch_sub(&w->pool->busy, 1);
         set_current(w, "");
+        /* after the worker is idle: whoever sees the job final sees the worker free */
+        gp_waiters_wake(svc->waiters, id);
     }
 }
 
@@ -532,6 +531,7 @@ int gp_pool_start(gp_service *svc, gp_pool **out)
     pthread_cond_init(&pool->retry, NULL);
     pthread_cond_init(&pool->gone, NULL);
     atomic_init(&pool->abandoned, 0);
+    atomic_init(&pool->stalled, 0);
     pthread_mutex_lock(&pool->lock);
     int rc = 0;
     for (int i = 0; i < n && rc == 0; i++)
