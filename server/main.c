@@ -133,6 +133,10 @@ int main(int argc, char **argv)
         gp_log("%d jobs the daemon died running %d times failed instead of being queued again "
                "(--max-job-attempts)", given_up, cfg.max_job_attempts);
     atomic_store(&svc.queued, counts[GP_JOB_ACCEPTED]);
+    if (gp_cursor_keys_init(&svc.cursor_keys)) {
+        gp_log("cannot draw the page cursors' keys from the kernel's random source");
+        goto done;
+    }
     if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
         gp_waiters_start(&svc.waiters) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");

@@ -7,6 +7,7 @@
 
 #include "auth.h"
 #include "config.h"
+#include "cursor.h"
 #include "metrics.h"
 #include "store.h"
 #include "waiters.h"
@@ -25,6 +26,7 @@ typedef struct gp_service {
     atomic_long queued;   /* accepted jobs not yet claimed: admission control and metrics */
     atomic_int accepting; /* 0 once shutdown began: submissions get 503 */
     double started;       /* monotonic seconds at start, for /health's uptime */
+    gp_cursor_keys cursor_keys; /* the keys of GET /jobs's page cursors (cursor.h) */
 } gp_service;
 
 #endif
