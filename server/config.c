@@ -34,7 +34,8 @@
  * address, and far below the file descriptor limit. */
 #define DEFAULT_MAX_CONNECTIONS 1024
 #define DEFAULT_MAX_CONNECTIONS_PER_IP 128
-/* A client that sends nothing for this long is disconnected (a slow-loris defence). A
+/* A client that sends nothing for this long is disconnected, and so is one whose request
+ * head is not complete this long after it began (a slow-loris defence: see peers.h). A
  * long-poll is not affected: a suspended connection is not timed out. */
 #define DEFAULT_CONNECTION_TIMEOUT 30
 
@@ -91,7 +92,8 @@ static const option options[] = {
      "connections open at once from one address before 429 (default 128)",
      INT(max_connections_per_ip, 1, 1000000)},
     {"--connection-timeout", "GRAINPACKD_CONNECTION_TIMEOUT",
-     "seconds a client may stay silent before it is disconnected (default 30)",
+     "seconds a client may stay silent, or take to send a request head, before it is "
+     "disconnected (default 30)",
      INT(connection_timeout, 1, 3600)},
     {"--key-file", "GRAINPACKD_KEY_FILE",
      "API keys (see README, Access control); without it the service is open to anyone",

@@ -32,7 +32,8 @@ typedef struct gp_config {
     int max_connections_per_ip; /* --max-connections-per-ip / GRAINPACKD_MAX_CONNECTIONS_PER_IP,
                                    default 128 */
     int connection_timeout;   /* --connection-timeout / GRAINPACKD_CONNECTION_TIMEOUT seconds a
-                                 silent client keeps its connection, default 30 */
+                                 silent client keeps its connection, and a request head may
+                                 take, default 30 */
     char key_file[PATH_MAX];  /* --key-file / GRAINPACKD_KEY_FILE: API keys; "" runs open */
     int insecure_open;        /* --insecure-open / GRAINPACKD_INSECURE_OPEN=1: run open (no key
                                  file) on an address other than loopback */

@@ -138,6 +138,7 @@ int main(int argc, char **argv)
         goto done;
     }
     if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
+        gp_peers_watch(svc.peers, (double)cfg.connection_timeout) ||
         gp_waiters_start(&svc.waiters) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");
         goto done;

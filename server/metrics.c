@@ -127,6 +127,15 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
             "still running after seconds; another took each one's place).\n"
             "# TYPE grainpack_workers_abandoned gauge\ngrainpack_workers_abandoned %d\n",
             g->queue_depth, g->workers, g->workers_busy, g->workers_abandoned);
+    fprintf(f,
+            "# HELP grainpack_http_slow_heads_total Connections answered 408 and closed: their "
+            "request head was not complete within --connection-timeout.\n"
+            "# TYPE grainpack_http_slow_heads_total counter\ngrainpack_http_slow_heads_total %lu\n"
+            "# HELP grainpack_http_long_polls_hung_up_total Long-polls ended because their "
+            "client closed the connection.\n"
+            "# TYPE grainpack_http_long_polls_hung_up_total counter\n"
+            "grainpack_http_long_polls_hung_up_total %lu\n",
+            g->slow_heads, g->polls_hung_up);
     fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
           "# TYPE grainpack_job_runs_total counter\n",
           f);

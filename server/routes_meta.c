@@ -5,6 +5,7 @@
 #include "embedded.h"
 #include "grainpack/version.h"
 #include "log.h"
+#include "peers.h"
 #include "problem.h"
 #include "routes.h"
 #include "workers.h"
@@ -123,6 +124,8 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     g.workers = svc->cfg->workers;
     g.workers_busy = gp_pool_busy(svc->pool);
     g.workers_abandoned = gp_pool_abandoned(svc->pool);
+    g.slow_heads = gp_peers_timed_out(svc->peers);
+    g.polls_hung_up = gp_waiters_hung_up(svc->waiters);
     size_t len;
     char *text = gp_metrics_render(svc->metrics, &g, &len);
     if (!text) {

@@ -1,6 +1,9 @@
 /* waiters.h - the long-poll of GET /jobs/{id}?wait=N: a request that must wait for a job
  * to finish is suspended (libmicrohttpd suspend/resume, so no HTTP thread is held) and
- * resumed when the job reaches a final status or its deadline passes.
+ * resumed when the job reaches a final status, its deadline passes, or its client hangs
+ * up (libmicrohttpd does not watch a suspended connection: the registry's thread polls
+ * their sockets, so that an abandoned wait gives back its place in the connection limits
+ * at once).
  *
  * Locking: one mutex guards the list; suspend and resume calls are made under it so that
  * a connection is never resumed before it was suspended. */
@@ -37,5 +40,8 @@ void gp_waiters_cancel(gp_waiters *w, gp_waiter *entry);
 
 /* The job reached a final status: resume its waiters. */
 void gp_waiters_wake(gp_waiters *w, const char *job_id);
+
+/* Waits ended so far because the client closed its connection. */
+unsigned long gp_waiters_hung_up(gp_waiters *w);
 
 #endif
