@@ -5,7 +5,7 @@ long-polls (hundreds of `?wait=` requests from several loopback addresses whose 
 then vanish), and large downloads (clients fetching big results at once). Prints
 markdown. Not a test: wall-clock figures, read with the load average.
 
-Usage: hostile.py GRAINPACKD [slowloris|polls|downloads ...]
+Usage: hostile.py GRAINPACKD [slowloris|polls|downloads|cancel ...]
   slowloris: 50 connections, one header byte each every second, --connection-timeout 5;
              /health timed over 12 s; when and how each trickler was closed.
   polls:     1000 long-polls (wait=60) from 10 addresses 127.0.0.2-11 on a job that runs
@@ -13,7 +13,9 @@ Usage: hostile.py GRAINPACKD [slowloris|polls|downloads ...]
              wait, and after they hang up; the slots they held, free again or not.
   downloads: a job of GP_BIG_SIDE (default 700: ~150 000 disks) with Laguerre cells,
              its JSON result fetched by 4 clients at once, over and over, for 15 s;
-             /health timed meanwhile."""
+             /health timed meanwhile.
+  cancel:    how soon a worker is free again after DELETE or the time limit of the issue's
+             endless histogram job, and after DELETE of a real job in each stage."""
 
 import json
 import os
@@ -141,10 +143,13 @@ def slowloris(binary):
 
 
 def polls(binary, count=1000, addresses=10):
-    # a job that runs for minutes (the first job stalls an hour: the test-only fault)
-    proc, port, d = start(binary, "--workers", "1", env={"GRAINPACKD_TEST_STALL_SECONDS": "3600"})
+    # a job that runs for minutes: the first job stalls an hour (the test-only fault), or,
+    # for a build without it, GP_POLL_SIDE makes the job big (4000: ~4.6 million disks)
+    side = int(os.environ.get("GP_POLL_SIDE", "100"))
+    proc, port, d = start(binary, "--workers", "1", "--max-disks", "100000000",
+                          env={"GRAINPACKD_TEST_STALL_SECONDS": "3600"})
     try:
-        spec = json.dumps({"inputs": {"domain": {"width": 100, "height": 100},
+        spec = json.dumps({"inputs": {"domain": {"width": side, "height": side},
                                       "distribution": {"kind": "constant", "radius": 1}}}).encode()
         req = urllib.request.Request(f"http://127.0.0.1:{port}/processes/pack2d/execution", data=spec,
                                      headers={"Content-Type": "application/json"})
@@ -219,12 +224,97 @@ def downloads(binary, seconds=15):
         stop(proc, d)
 
 
+def submit(port, spec):
+    req = urllib.request.Request(f"http://127.0.0.1:{port}/processes/pack2d/execution",
+                                 data=json.dumps(spec).encode(), headers={"Content-Type": "application/json"})
+    return urllib.request.urlopen(req).headers["Location"]
+
+
+def status(port, job):
+    return json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}"))
+
+
+def until(predicate, limit=600, period=0.005):
+    t = time.monotonic()
+    while not predicate():
+        if time.monotonic() - t > limit:
+            return None
+        time.sleep(period)
+    return time.monotonic() - t
+
+
+PATHOLOGICAL = {"inputs": {"domain": {"width": 100, "height": 100},
+                           "distribution": {"kind": "histogram", "bins": [{"min": 1e-06, "max": 2e-06, "p": 0.5},
+                                                                          {"min": 1, "max": 1.1, "p": 0.5}]}}}
+STAGED = {"inputs": {"domain": {"width": 2280, "height": 2280}, "distribution": {"kind": "constant", "radius": 1},
+                     "joint": {"law": "constant", "value": 0.1},
+                     "balance": {"method": "relocation", "max_iterations": 5}, "laguerre": {"shrink": "offset"}}}
+TINY = {"inputs": {"domain": {"width": 10, "height": 10}, "distribution": {"kind": "constant", "radius": 0.9}}}
+
+
+def busy(port):
+    return json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/health"))["workers_busy"]
+
+
+def cancel(binary):
+    """How soon a worker is free again: after DELETE of the issue's endless histogram job,
+    after its time limit, and after DELETE of a real 1.2-million-disk job in each stage."""
+    proc, port, d = start(binary, "--workers", "1", "--max-job-seconds", "5", "--max-disks", "10000000")
+    try:
+        rows = []
+        job = submit(port, PATHOLOGICAL)
+        until(lambda: status(port, job)["status"] == "running")
+        time.sleep(1)
+        t = time.monotonic()
+        urllib.request.urlopen(urllib.request.Request(f"http://127.0.0.1:{port}{job}", method="DELETE"))
+        free = until(lambda: busy(port) == 0)
+        tiny = submit(port, TINY)
+        until(lambda: status(port, tiny)["status"] == "successful")
+        rows.append(("the issue's histogram job, DELETE 1 s after it started", free, time.monotonic() - t))
+        job = submit(port, PATHOLOGICAL)
+        until(lambda: status(port, job)["status"] == "running")
+        t = time.monotonic()
+        until(lambda: status(port, job)["status"] == "failed")
+        failed = time.monotonic() - t
+        free = until(lambda: busy(port) == 0)
+        tiny = submit(port, TINY)
+        until(lambda: status(port, tiny)["status"] == "successful")
+        rows.append((f"the same, left to its 5 s limit (failed {failed:.2f} s after it started)", failed + free,
+                     time.monotonic() - t))
+        stop(proc, d)
+        proc, port, d = start(binary, "--workers", "1", "--max-disks", "10000000")
+        for stage in ("pack", "triangulation", "balance", "laguerre"):
+            job = submit(port, STAGED)
+            if until(lambda: stage in status(port, job).get("message", ""), limit=120, period=0.02) is None:
+                rows.append((f"1.2 million disks, DELETE in {stage}: stage not seen", None, None))
+                continue
+            t = time.monotonic()
+            urllib.request.urlopen(urllib.request.Request(f"http://127.0.0.1:{port}{job}", method="DELETE"))
+            free = until(lambda: busy(port) == 0)
+            tiny = submit(port, TINY)
+            until(lambda: status(port, tiny)["status"] == "successful")
+            rows.append((f"1.2 million disks (relocation, cells), DELETE in {stage}", free, time.monotonic() - t))
+        metrics = urllib.request.urlopen(f"http://127.0.0.1:{port}/metrics").read().decode()
+        abandoned = [line for line in metrics.splitlines() if line.startswith('grainpack_job_runs_total{outcome="abandoned"}')]
+        for what, free, tiny in rows:
+            print(f"| {what} | {'-' if free is None else f'{1e3 * free:.0f} ms'} | "
+                  f"{'-' if tiny is None else f'{1e3 * tiny:.0f} ms'} | {load():.2f} |")
+        print(f"\n{abandoned[0] if abandoned else ''}")
+    finally:
+        stop(proc, d)
+
+
 def main():
-    binary, modes = sys.argv[1], sys.argv[2:] or ["slowloris", "polls", "downloads"]
+    binary, modes = sys.argv[1], sys.argv[2:] or ["slowloris", "polls", "downloads", "cancel"]
     print(f"Load average {load():.2f} at the start; 2 cores shared.\n")
-    print("| attack | /health on a new connection | what became of the attackers | load |\n|---|---|---|---|")
-    for mode in modes:
+    attacks = [m for m in modes if m != "cancel"]
+    if attacks:
+        print("| attack | /health on a new connection | what became of the attackers | load |\n|---|---|---|---|")
+    for mode in attacks:
         {"slowloris": slowloris, "polls": polls, "downloads": downloads}[mode](binary)
+    if "cancel" in modes:
+        print("\n| job stopped | worker free (workers_busy 0) after | a tiny job done after | load |\n|---|---|---|---|")
+        cancel(binary)
 
 
 if __name__ == "__main__":

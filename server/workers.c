@@ -44,8 +44,10 @@
 #define ABANDON_SECONDS 2.0
 
 /* At most this many workers given up on, per worker of the pool, still run: beyond, the
- * pool stops replacing them rather than start threads without end. */
-#define ABANDONED_PER_WORKER 1
+ * pool stops replacing them rather than start threads without end (each one that never
+ * returns takes what processor time the others leave: they all run at the lowest
+ * priority). Their jobs are failed all the same. */
+#define ABANDONED_PER_WORKER 4
 
 /* How long a failed start waits for the workers it started (idle: they return at once). */
 #define STARTUP_STOP_SECONDS 10.0
@@ -75,12 +77,16 @@ typedef struct worker {
     double deadline;             /* monotonic seconds it must end by, 0: none; pool->lock */
     double started;              /* monotonic seconds it started, for the failure message */
     double canceled_at;          /* monotonic seconds its flag was raised, 0: not; pool->lock */
-    int abandoned;               /* given up on (see ABANDON_SECONDS); pool->lock */
+    int abandoned;               /* given up on and replaced (see ABANDON_SECONDS); pool->lock */
+    int given_up;                /* given up on but kept in its slot, no replacement
+                                    possible (its job recorded as for one replaced) */
     int storing;                 /* its pipeline returned, the outcome is being stored: no
                                     time limit, no giving up any more; pool->lock */
     gp_db *db;                   /* its own connection, for the thread's lifetime */
     double last_write;           /* progress throttling */
     int last_percent;
+    const char *stages[4];       /* the stages of the job (plan_stages) */
+    int nstages;
 } worker;
 
 struct gp_pool {
@@ -114,7 +120,13 @@ static void report_progress(void *ctx, const char *stage, double fraction)
         while (nanosleep(&ts, &ts) != 0)
             ;
     }
-    int percent = (int)(fraction * 100.0);
+    /* the job's progress: each stage the spec runs has an equal share, in order, so that
+     * it only rises; the message names the stage and how far it got */
+    int k = 0;
+    while (k < w->nstages - 1 && strcmp(w->stages[k], stage) != 0)
+        k++;
+    double overall = ((double)k + (fraction < 0 ? 0 : fraction > 1 ? 1 : fraction)) / w->nstages;
+    int percent = (int)(overall * 100.0), local = (int)(fraction * 100.0);
     percent = percent < 0 ? 0 : (percent > 99 ? 99 : percent); /* 100 means stored */
     if (percent <= w->last_percent)
         return;
@@ -122,11 +134,24 @@ static void report_progress(void *ctx, const char *stage, double fraction)
     if (now - w->last_write < PROGRESS_INTERVAL)
         return;
     char message[64];
-    snprintf(message, sizeof message, "running: %s %d%%", stage, percent);
+    snprintf(message, sizeof message, "running: %s %d%%", stage, local < 0 ? 0 : local > 99 ? 99 : local);
     if (gp_store_progress(w->db, w->job_id, percent, message) == 0) {
         w->last_percent = percent;
         w->last_write = now;
     }
+}
+
+/* The stages the spec runs, in order, for report_progress. */
+static void plan_stages(worker *w, const gp_spec *spec)
+{
+    w->nstages = 0;
+    w->stages[w->nstages++] = "pack";
+    if (spec->balance_enabled || spec->laguerre_enabled)
+        w->stages[w->nstages++] = "triangulation";
+    if (spec->balance_enabled)
+        w->stages[w->nstages++] = "balance";
+    if (spec->laguerre_enabled)
+        w->stages[w->nstages++] = "laguerre";
 }
 
 /* Publishes or clears the job a worker runs (under the pool lock, so that a cancel
@@ -141,6 +166,7 @@ static void set_current(worker *w, const char *id)
     w->started = gp_monotonic_seconds();
     w->canceled_at = pool->stopping ? w->started : 0;
     w->storing = 0;
+    w->given_up = 0;
     w->deadline = id[0] && limit > 0 ? w->started + limit : 0;
     pthread_cond_signal(&pool->watch);
     pthread_mutex_unlock(&pool->lock);
@@ -208,25 +234,30 @@ typedef struct given_up {
     char id[GP_JOB_ID_SIZE];
     int why;
     double ran;
+    int replaced; /* another worker took its place */
 } given_up;
 
-/* Gives up on the worker in slot i, told to stop ABANDON_SECONDS ago and still running,
- * and starts another in its place (pool->lock held). Returns 1 when it did, with the job
- * in *job; 0 when no thread can be started (the worker stays in its slot). */
+/* Gives up on the worker in slot i, told to stop ABANDON_SECONDS ago and still running
+ * (pool->lock held): another thread takes its place when one can be started (under the
+ * ABANDONED_PER_WORKER cap), else it stays in its slot. Either way its job goes to *job,
+ * to be recorded. Returns 1 when replaced, 0 when not. */
 static int abandon(gp_pool *pool, int i, double now, given_up *job)
 {
     worker *w = pool->workers[i];
-    if (atomic_load(&pool->abandoned) >= ABANDONED_PER_WORKER * pool->n || start_worker(pool, i)) {
+    snprintf(job->id, sizeof job->id, "%s", w->job_id);
+    job->why = atomic_load(&w->cancel);
+    job->ran = now - w->started;
+    job->replaced = atomic_load(&pool->abandoned) < ABANDONED_PER_WORKER * pool->n &&
+                    start_worker(pool, i) == 0;
+    if (!job->replaced) {
         pool->workers[i] = w;
+        w->given_up = 1;
         return 0;
     }
     w->abandoned = 1;
     pthread_detach(w->thread);
     atomic_fetch_add(&pool->abandoned, 1);
     atomic_fetch_sub(&pool->busy, 1);
-    snprintf(job->id, sizeof job->id, "%s", w->job_id);
-    job->why = atomic_load(&w->cancel);
-    job->ran = now - w->started;
     return 1;
 }
 
@@ -235,10 +266,13 @@ static int abandon(gp_pool *pool, int i, double now, given_up *job)
 static void record_given_up(gp_pool *pool, const given_up *job)
 {
     gp_service *svc = pool->svc;
-    gp_log("job %s: its worker did not stop within %.0f s of being told to (%s); another "
-           "worker takes its place, and the job's result is dropped if it ever comes",
+    gp_log("job %s: its worker did not stop within %.0f s of being told to (%s); %s",
            job->id, ABANDON_SECONDS,
-           job->why == CANCEL_TIMEOUT ? "time limit" : job->why == CANCEL_DISMISSED ? "dismissed" : "stop");
+           job->why == CANCEL_TIMEOUT ? "time limit" : job->why == CANCEL_DISMISSED ? "dismissed" : "stop",
+           job->replaced ? "another worker takes its place, and the job's result is dropped if it "
+                           "ever comes"
+                         : "too many workers were given up on already: it keeps its place "
+                           "(restart the daemon to get it back)");
     gp_metrics_outcome(svc->metrics, "abandoned");
     if (job->why == CANCEL_TIMEOUT) {
         char message[TIMEOUT_MESSAGE_SIZE];
@@ -266,15 +300,15 @@ static void *watchdog_main(void *arg)
         double now = gp_monotonic_seconds(), next = now + 1.0;
         for (int i = 0; i < pool->n; i++) {
             worker *w = pool->workers[i];
-            if (!w->job_id[0] || w->storing)
+            if (!w->job_id[0] || w->storing || w->given_up)
                 continue;
             if (w->deadline > 0 && now >= w->deadline)
                 raise_cancel(w, CANCEL_TIMEOUT, now);
             else if (w->deadline > 0 && w->deadline < next)
                 next = w->deadline;
             given_up job;
-            if (w->canceled_at > 0 && now - w->canceled_at >= ABANDON_SECONDS &&
-                abandon(pool, i, now, &job)) {
+            if (w->canceled_at > 0 && now - w->canceled_at >= ABANDON_SECONDS) {
+                abandon(pool, i, now, &job);
                 pthread_mutex_unlock(&pool->lock);
                 record_given_up(pool, &job);
                 pthread_mutex_lock(&pool->lock);
@@ -412,14 +446,17 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     memset(&result, 0, sizeof result);
     int rc = gp_spec_parse(spec_text, spec_len, &unlimited, &spec, &err);
     if (rc == 0) {
+        plan_stages(w, &spec);
         gp_progress progress = {report_progress, w, &w->cancel};
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
     }
     pthread_mutex_lock(&w->pool->lock);
-    int abandoned = w->abandoned;
+    /* a worker given up on had its job recorded then (failed, or dismissed already): what
+     * it brings back now is dropped, whether it was replaced or kept its slot */
+    int abandoned = w->abandoned, kept = w->given_up;
     w->storing = 1;
     pthread_mutex_unlock(&w->pool->lock);
-    if (abandoned)
+    if (abandoned || kept)
         gp_log("job %s: the worker given up on returned after %.1f s; its outcome is dropped", id,
                gp_monotonic_seconds() - w->started);
     else
