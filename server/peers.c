@@ -38,6 +38,7 @@ struct gp_peers {
     char answer[512];     /* the 408 sent before a slow head's connection is shut */
     size_t answer_len;
     unsigned long timed_out;
+    atomic_ulong *closed; /* the caller's count of them (gp_peers_watch) */
 };
 
 gp_peers *gp_peers_new(void)
@@ -189,14 +190,6 @@ void gp_peers_head_begins(gp_peers *p, gp_peer_conn *conn)
     pthread_mutex_unlock(&p->lock);
 }
 
-unsigned long gp_peers_timed_out(gp_peers *p)
-{
-    pthread_mutex_lock(&p->lock);
-    unsigned long n = p->timed_out;
-    pthread_mutex_unlock(&p->lock);
-    return n;
-}
-
 /* Closes every connection whose head is late (lock held): the 408 (when its request line
  * came), then a shutdown, which libmicrohttpd sees as the client's end and closes the
  * connection itself. */
@@ -207,6 +200,7 @@ static void close_late_heads(gp_peers *p, double now)
             continue;
         c->timed_out = 1;
         p->timed_out++;
+        atomic_fetch_add(p->closed, 1);
         /* best effort, never blocking: a client that does not read it is closed anyway */
         if (c->line_in && send(c->fd, p->answer, p->answer_len, MSG_DONTWAIT | MSG_NOSIGNAL) < 0) {
             /* nothing to do: the shutdown below closes it */
@@ -237,9 +231,10 @@ static void *watch_main(void *arg)
     return NULL;
 }
 
-int gp_peers_watch(gp_peers *p, double seconds)
+int gp_peers_watch(gp_peers *p, double seconds, atomic_ulong *closed)
 {
     p->head_seconds = seconds;
+    p->closed = closed;
     char body[256];
     int blen = snprintf(body, sizeof body,
                         "{\"type\":\"urn:grainpack:problem:request-timeout\",\"title\":"

@@ -19,6 +19,7 @@
 #ifndef GRAINPACKD_PEERS_H
 #define GRAINPACKD_PEERS_H
 
+#include <stdatomic.h>
 #include <sys/socket.h>
 
 typedef struct gp_peers gp_peers;
@@ -53,11 +54,10 @@ void gp_peers_head_done(gp_peers *p, gp_peer_conn *conn);
 void gp_peers_head_begins(gp_peers *p, gp_peer_conn *conn);
 
 /* Starts the watcher: a head not complete `seconds` after it began gets a 408 problem
- * and its connection is shut down. Returns 0 or GP_ENOMEM. gp_peers_free stops it. */
-int gp_peers_watch(gp_peers *p, double seconds);
-
-/* Connections the watcher closed so far. */
-unsigned long gp_peers_timed_out(gp_peers *p);
+ * and its connection is shut down, counted in *closed (not owned: it must outlive p; a
+ * counter the routes read without linking this file). Returns 0 or GP_ENOMEM.
+ * gp_peers_free stops it. */
+int gp_peers_watch(gp_peers *p, double seconds, atomic_ulong *closed);
 
 /* The connection closed: its record is freed. NULL is a no-op. */
 void gp_peers_closed(gp_peers *p, gp_peer_conn *conn);

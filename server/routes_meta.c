@@ -5,7 +5,6 @@
 #include "embedded.h"
 #include "grainpack/version.h"
 #include "log.h"
-#include "peers.h"
 #include "problem.h"
 #include "routes.h"
 #include "workers.h"
@@ -22,14 +21,18 @@ static json_t *make_link(const char *href, const char *rel, const char *type, co
 
 int gp_route_landing(gp_request *req, gp_reply *reply)
 {
-    (void)req;
+    reply->vary = "Accept"; /* the page for a browser, this document for the others */
+    int page = gp_route_web_wants_page(req, reply);
+    if (page)
+        return page < 0 ? GP_ROUTE_DONE : gp_route_web_page(req, reply);
     json_t *body = json_pack(
-        "{s:s, s:s, s:[o, o, o, o, o, o, o]}", "title", "grainpack",
+        "{s:s, s:s, s:[o, o, o, o, o, o, o, o]}", "title", "grainpack",
         "description",
         "Packs a rectangle with disks whose radii follow a distribution (advancing-front "
         "method of INRIA report RR-6414), as asynchronous jobs in the style of OGC API - "
         "Processes.",
         "links", make_link("/", "self", JSON_TYPE, "this document"),
+        make_link("/?f=html", "alternate", "text/html", "the web page: design, run and look at jobs"),
         make_link("/openapi.yaml", "service-desc", "application/vnd.oai.openapi;version=3.1",
              "the API definition (OpenAPI 3.1)"),
         make_link("/conformance", OGC_REL "conformance", JSON_TYPE, "conformance classes"),
@@ -124,7 +127,7 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     g.workers = svc->cfg->workers;
     g.workers_busy = gp_pool_busy(svc->pool);
     g.workers_abandoned = gp_pool_abandoned(svc->pool);
-    g.slow_heads = gp_peers_timed_out(svc->peers);
+    g.slow_heads = atomic_load(&svc->slow_heads);
     g.polls_hung_up = gp_waiters_hung_up(svc->waiters);
     size_t len;
     char *text = gp_metrics_render(svc->metrics, &g, &len);

@@ -25,6 +25,8 @@ typedef struct gp_service {
     gp_peers *peers;      /* connections per client address */
     atomic_long queued;   /* accepted jobs not yet claimed: admission control and metrics */
     atomic_int accepting; /* 0 once shutdown began: submissions get 503 */
+    atomic_ulong slow_heads; /* connections closed for a late request head (peers.c's
+                                watcher counts them; /metrics reads them) */
     double started;       /* monotonic seconds at start, for /health's uptime */
     gp_cursor_keys cursor_keys; /* the keys of GET /jobs's page cursors (cursor.h) */
 } gp_service;

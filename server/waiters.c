@@ -21,7 +21,7 @@
 #define MAX_SLEEP_SECONDS 1.0
 
 struct gp_waiter {
-    struct MHD_Connection *conn;
+    void *conn;
     int fd;          /* the connection's socket, watched for the client's hang-up */
     uint64_t serial; /* tells this entry from a later one at the same address */
     char job_id[GP_JOB_ID_SIZE];
@@ -34,6 +34,7 @@ struct gp_waiter {
 struct gp_waiters {
     pthread_mutex_t lock; /* guards head, stopping, closed; held around suspend/resume */
     gp_waiter *head;
+    const gp_suspender *how;
     int stopping;
     int wake_fd;     /* an eventfd: written when the thread must look again (a new
                         suspension, a stop) */
@@ -57,7 +58,7 @@ static void release(gp_waiters *w, gp_waiter *e)
         }
     }
     if (e->suspended)
-        MHD_resume_connection(e->conn);
+        w->how->resume(e->conn);
     free(e);
 }
 
@@ -150,11 +151,12 @@ static void *deadline_thread(void *arg)
     return NULL;
 }
 
-int gp_waiters_start(gp_waiters **out)
+int gp_waiters_start(gp_waiters **out, const gp_suspender *how)
 {
     gp_waiters *w = calloc(1, sizeof *w);
     if (!w)
         return GP_ENOMEM;
+    w->how = how;
     pthread_mutex_init(&w->lock, NULL);
     w->fds = malloc(sizeof *w->fds);
     w->serials = malloc(sizeof *w->serials);
@@ -222,16 +224,14 @@ void gp_waiters_free(gp_waiters *w)
     free(w);
 }
 
-gp_waiter *gp_waiters_add(gp_waiters *w, struct MHD_Connection *conn, const char *job_id,
-                          double deadline)
+gp_waiter *gp_waiters_add(gp_waiters *w, void *conn, const char *job_id, double deadline)
 {
     gp_waiter *e = calloc(1, sizeof *e);
     if (!e)
         return NULL;
     e->conn = conn;
     e->deadline = deadline;
-    const union MHD_ConnectionInfo *fd = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
-    e->fd = fd ? fd->connect_fd : -1;
+    e->fd = w->how->socket(conn);
     snprintf(e->job_id, sizeof e->job_id, "%s", job_id);
     pthread_mutex_lock(&w->lock);
     if (w->stopping) {
@@ -251,7 +251,7 @@ int gp_waiters_suspend(gp_waiters *w, gp_waiter *entry)
     pthread_mutex_lock(&w->lock);
     int suspend = !entry->woken && !w->stopping;
     if (suspend) {
-        MHD_suspend_connection(entry->conn);
+        w->how->suspend(entry->conn);
         entry->suspended = 1;
         nudge(w); /* the deadline thread watches its socket, and may need to wake sooner */
     } else {
