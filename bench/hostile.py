@@ -11,7 +11,7 @@ Usage: hostile.py GRAINPACKD [slowloris|polls|downloads|cancel ...]
   polls:     1000 long-polls (wait=60) from 10 addresses 127.0.0.2-11 on a job that runs
              for minutes, all closed by their clients; /health timed before, while they
              wait, and after they hang up; the slots they held, free again or not.
-  downloads: a job of GP_BIG_SIDE (default 700: ~150 000 disks) with Laguerre cells,
+  downloads: a job of GP_BIG_SIDE (default 980: ~290 000 disks) with Laguerre cells,
              its JSON result fetched by 4 clients at once, over and over, for 15 s;
              /health timed meanwhile.
   cancel:    how soon a worker is free again after DELETE or the time limit of the issue's
@@ -192,7 +192,8 @@ def polls(binary, count=1000, addresses=10):
 
 
 def downloads(binary, seconds=15):
-    side = int(os.environ.get("GP_BIG_SIDE", "700"))
+    # 980: ~290 000 disks, the 287 704-disk job (148 MiB as JSON with its cells)
+    side = int(os.environ.get("GP_BIG_SIDE", "980"))
     proc, port, d = start(binary, "--workers", "1")
     try:
         spec = json.dumps({"inputs": {"domain": {"width": side, "height": side},
@@ -204,6 +205,7 @@ def downloads(binary, seconds=15):
         while json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}?wait=60"))["status"] != "successful":
             pass
         size = len(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/results?f=json").read())
+        disks = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/statistics"))["count"]
         stop_at = time.monotonic() + seconds
         fetched = [0]
 
@@ -218,7 +220,8 @@ def downloads(binary, seconds=15):
         times = sample_health(port, seconds)
         for th in threads:
             th.join()
-        print(f"| 4 clients downloading a {size / 2**20:.0f} MiB JSON result over and over ({fetched[0]} "
+        print(f"| 4 clients downloading a {disks}-disk result with its cells as JSON, {size / 2**20:.0f} MiB, "
+              f"over and over ({fetched[0]} "
               f"downloads in {seconds} s) | {summary(times)} | | {load():.2f} |")
     finally:
         stop(proc, d)

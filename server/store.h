@@ -7,6 +7,7 @@
 #ifndef GRAINPACKD_STORE_H
 #define GRAINPACKD_STORE_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -113,9 +114,13 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
                        size_t limit, gp_job *out, size_t *n, int *more);
 
 /* Claims the oldest accepted job atomically (UPDATE ... RETURNING): it becomes running.
- * Returns 0 with the id and a malloc'd copy of its spec text (caller frees), or
- * GP_SRV_ENOTFOUND when none waits, or GP_SRV_EDB. */
-int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len);
+ * *queued (the caller's count of accepted jobs; may be NULL) is decremented before the
+ * claim commits and given back if the commit fails, so that whoever sees the job running
+ * sees it out of the queue (the --max-queued admission reads that count). Returns 0
+ * with the id and a malloc'd copy of its spec text (caller frees), or GP_SRV_ENOTFOUND
+ * when none waits, or GP_SRV_EDB. */
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len);
 
 /* Records the progress of a running job (no-op when it is no longer running). */
 int gp_store_progress(gp_db *db, const char *id, int percent, const char *message);

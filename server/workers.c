@@ -430,7 +430,6 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
 {
     gp_service *svc = w->pool->svc;
     set_current(w, id);
-    atomic_fetch_sub(&svc->queued, 1);
     atomic_fetch_add(&w->pool->busy, 1);
     gp_log("job %s running", id);
     w->last_percent = 0;
@@ -533,7 +532,7 @@ static void *worker_main(void *arg)
         }
         char id[GP_JOB_ID_SIZE], *spec_text;
         size_t spec_len;
-        int rc = gp_store_claim(w->db, id, &spec_text, &spec_len);
+        int rc = gp_store_claim(w->db, &pool->svc->queued, id, &spec_text, &spec_len);
         if (rc == 0) {
             run_job(w, id, spec_text, spec_len);
             free(spec_text);
