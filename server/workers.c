@@ -40,7 +40,11 @@
  * is given up on: another thread takes its place, and it frees itself if it ever returns.
  * Every stage reads its flag within milliseconds (bench/CANCEL.md: under 0.1 s of CPU for
  * a million disks, freeing included), so only a stage that ignores it, or a store write
- * held up (sqlite waits up to 30 s for another process's write lock), comes this far. */
+ * held up (sqlite waits up to 30 s for another process's write lock), comes this far.
+ * The seconds exclude the time the worker waited for a processor (its run-queue wait,
+ * from /proc's schedstat): a SCHED_IDLE worker on a loaded machine may get no processor
+ * for seconds, and was then never given the chance to read its flag (test_service_limits
+ * saw a job stopped by a 0.2 s limit given up on at a load of 20). */
 #define ABANDON_SECONDS 2.0
 
 /* At most this many workers given up on, per worker of the pool, still run: beyond, the
@@ -77,6 +81,8 @@ typedef struct worker {
     double deadline;             /* monotonic seconds it must end by, 0: none; pool->lock */
     double started;              /* monotonic seconds it started, for the failure message */
     double canceled_at;          /* monotonic seconds its flag was raised, 0: not; pool->lock */
+    double queued_at_cancel;     /* its run-queue wait then (run_queue_seconds); pool->lock */
+    pid_t tid;                   /* its thread's id, for /proc; pool->lock */
     int abandoned;               /* given up on and replaced (see ABANDON_SECONDS); pool->lock */
     int given_up;                /* given up on but kept in its slot, no replacement
                                     possible (its job recorded as for one replaced) */
@@ -154,6 +160,36 @@ static void plan_stages(worker *w, const gp_spec *spec)
         w->stages[w->nstages++] = "laguerre";
 }
 
+/* Seconds the thread tid has waited for a processor since it started (the second field
+ * of /proc/self/task/TID/schedstat), or -1 when the kernel does not say. */
+static double run_queue_seconds(pid_t tid)
+{
+    char path[64];
+    snprintf(path, sizeof path, "/proc/self/task/%ld/schedstat", (long)tid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    unsigned long long ran, waited;
+    int got = fscanf(f, "%llu %llu", &ran, &waited);
+    fclose(f);
+    return got == 2 ? (double)waited * 1e-9 : -1;
+}
+
+/* Seconds the worker has had to stop since its flag was raised (pool->lock held): the
+ * time since then, less what it spent waiting for a processor. */
+static double time_to_stop(const worker *w, double now)
+{
+    double queued = w->queued_at_cancel >= 0 ? run_queue_seconds(w->tid) : -1;
+    return now - w->canceled_at - (queued >= 0 ? queued - w->queued_at_cancel : 0);
+}
+
+/* Starts the clock of ABANDON_SECONDS (pool->lock held). */
+static void start_stop_clock(worker *w, double now)
+{
+    w->canceled_at = now;
+    w->queued_at_cancel = w->tid ? run_queue_seconds(w->tid) : -1;
+}
+
 /* Publishes or clears the job a worker runs (under the pool lock, so that a cancel
  * either finds it or comes after it is done). */
 static void set_current(worker *w, const char *id)
@@ -164,7 +200,9 @@ static void set_current(worker *w, const char *id)
     atomic_store(&w->cancel, pool->stopping ? CANCEL_SHUTDOWN : CANCEL_NONE);
     snprintf(w->job_id, sizeof w->job_id, "%s", id);
     w->started = gp_monotonic_seconds();
-    w->canceled_at = pool->stopping ? w->started : 0;
+    w->canceled_at = 0;
+    if (pool->stopping)
+        start_stop_clock(w, w->started);
     w->storing = 0;
     w->given_up = 0;
     w->deadline = id[0] && limit > 0 ? w->started + limit : 0;
@@ -207,7 +245,7 @@ static void raise_cancel(worker *w, int why, double now)
         atomic_store(&w->cancel, why);
     }
     if (w->canceled_at <= 0)
-        w->canceled_at = now;
+        start_stop_clock(w, now);
 }
 
 static void *worker_main(void *arg);
@@ -307,7 +345,7 @@ static void *watchdog_main(void *arg)
             else if (w->deadline > 0 && w->deadline < next)
                 next = w->deadline;
             given_up job;
-            if (w->canceled_at > 0 && now - w->canceled_at >= ABANDON_SECONDS) {
+            if (w->canceled_at > 0 && time_to_stop(w, now) >= ABANDON_SECONDS) {
                 abandon(pool, i, now, &job);
                 pthread_mutex_unlock(&pool->lock);
                 record_given_up(pool, &job);
@@ -515,6 +553,9 @@ static void *worker_main(void *arg)
      * GET p99 8.7-11.5 ms while both workers packed, against 7.9-10.0 ms with SCHED_IDLE
      * (bench/service.sh, 2 cores). The price: under a request load that fills every core,
      * workers get less time (bench/load.sh: 2181-2244 jobs a minute, against 2509-2581). */
+    pthread_mutex_lock(&pool->lock);
+    w->tid = (pid_t)syscall(SYS_gettid);
+    pthread_mutex_unlock(&pool->lock);
     struct sched_param idle = {0};
     if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0 &&
         setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), WORKER_NICE) != 0)
