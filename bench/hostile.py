@@ -17,6 +17,7 @@ Usage: hostile.py GRAINPACKD [slowloris|polls|downloads|cancel ...]
   cancel:    how soon a worker is free again after DELETE or the time limit of the issue's
              endless histogram job, and after DELETE of a real job in each stage."""
 
+import http.client
 import json
 import os
 import shutil
@@ -207,12 +208,15 @@ def downloads(binary, seconds=15):
         size = len(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/results?f=json").read())
         disks = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/statistics"))["count"]
         stop_at = time.monotonic() + seconds
-        fetched = [0]
+        fetched, failed = [0], [0]
 
         def fetch():
             while time.monotonic() < stop_at:
-                urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/results?f=json", timeout=120).read()
-                fetched[0] += 1
+                try:
+                    urllib.request.urlopen(f"http://127.0.0.1:{port}{job}/results?f=json", timeout=120).read()
+                    fetched[0] += 1
+                except (OSError, http.client.HTTPException):  # refused or cut off: counted
+                    failed[0] += 1
 
         threads = [threading.Thread(target=fetch) for _ in range(4)]
         for th in threads:
@@ -221,8 +225,8 @@ def downloads(binary, seconds=15):
         for th in threads:
             th.join()
         print(f"| 4 clients downloading a {disks}-disk result with its cells as JSON, {size / 2**20:.0f} MiB, "
-              f"over and over ({fetched[0]} "
-              f"downloads in {seconds} s) | {summary(times)} | | {load():.2f} |")
+              f"over and over ({fetched[0]} downloads in {seconds} s) | {summary(times)} | "
+              f"{failed[0]} downloads failed | {load():.2f} |")
     finally:
         stop(proc, d)
 

@@ -101,7 +101,8 @@ int main(int argc, char **argv)
     svc.started = gp_monotonic_seconds();
     atomic_init(&svc.queued, 0);
     atomic_init(&svc.accepting, 1);
-    atomic_init(&svc.slow_heads, 0);
+    atomic_init(&svc.http.open, 0);
+    atomic_init(&svc.http.slow_heads, 0);
     struct MHD_Daemon *http = NULL;
     int status = 1, requeued = 0, given_up = 0, lock_fd = -1;
     char why[512];
@@ -138,8 +139,8 @@ int main(int argc, char **argv)
         gp_log("cannot draw the page cursors' keys from the kernel's random source");
         goto done;
     }
-    if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
-        gp_peers_watch(svc.peers, (double)cfg.connection_timeout, &svc.slow_heads) ||
+    if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new(&svc.http)) ||
+        gp_peers_watch(svc.peers, (double)cfg.connection_timeout) ||
         gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");
         goto done;

@@ -134,8 +134,10 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
             "# HELP grainpack_http_long_polls_hung_up_total Long-polls ended because their "
             "client closed the connection.\n"
             "# TYPE grainpack_http_long_polls_hung_up_total counter\n"
-            "grainpack_http_long_polls_hung_up_total %lu\n",
-            g->slow_heads, g->polls_hung_up);
+            "grainpack_http_long_polls_hung_up_total %lu\n"
+            "# HELP grainpack_http_connections HTTP connections open, waiting long-polls "
+            "included.\n# TYPE grainpack_http_connections gauge\ngrainpack_http_connections %ld\n",
+            g->slow_heads, g->polls_hung_up, g->connections);
     fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
           "# TYPE grainpack_job_runs_total counter\n",
           f);

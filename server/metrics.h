@@ -32,6 +32,7 @@ typedef struct gp_metrics_gauges {
     long queue_depth;          /* accepted jobs waiting for a worker */
     int workers, workers_busy, workers_abandoned;
     unsigned long slow_heads;     /* connections closed for a late request head */
+    long connections;             /* HTTP connections open */
     unsigned long polls_hung_up;  /* long-polls ended by their client's hang-up */
 } gp_metrics_gauges;
 

@@ -39,13 +39,14 @@ struct gp_peers {
     char answer[512];     /* the 408 sent before a slow head's connection is shut */
     size_t answer_len;
     unsigned long timed_out;
-    atomic_ulong *closed; /* the caller's count of them (gp_peers_watch) */
+    gp_peer_counts *counts; /* the caller's (gp_peers_new) */
 };
 
-gp_peers *gp_peers_new(void)
+gp_peers *gp_peers_new(gp_peer_counts *counts)
 {
     gp_peers *p = calloc(1, sizeof *p);
     if (p) {
+        p->counts = counts;
         pthread_mutex_init(&p->lock, NULL);
         pthread_cond_init(&p->stop, NULL);
     }
@@ -130,6 +131,7 @@ gp_peer_conn *gp_peers_opened(gp_peers *p, const struct sockaddr *addr, unsigned
         if (p->conns)
             p->conns->prev = conn;
         p->conns = conn;
+        atomic_fetch_add(&p->counts->open, 1);
     }
     pthread_mutex_unlock(&p->lock);
     if (!e) {
@@ -158,6 +160,7 @@ void gp_peers_closed(gp_peers *p, gp_peer_conn *conn)
         *link = e->next;
         free(e);
     }
+    atomic_fetch_sub(&p->counts->open, 1);
     pthread_mutex_unlock(&p->lock);
     free(conn);
 }
@@ -208,7 +211,7 @@ static void close_late_heads(gp_peers *p, double now)
             continue;
         c->timed_out = 1;
         p->timed_out++;
-        atomic_fetch_add(p->closed, 1);
+        atomic_fetch_add(&p->counts->slow_heads, 1);
         /* best effort, never blocking: a client that does not read it is closed anyway */
         if (c->line_in && send(c->fd, p->answer, p->answer_len, MSG_DONTWAIT | MSG_NOSIGNAL) < 0) {
             /* nothing to do: the shutdown below closes it */
@@ -239,10 +242,9 @@ static void *watch_main(void *arg)
     return NULL;
 }
 
-int gp_peers_watch(gp_peers *p, double seconds, atomic_ulong *closed)
+int gp_peers_watch(gp_peers *p, double seconds)
 {
     p->head_seconds = seconds;
-    p->closed = closed;
     char body[256];
     int blen = snprintf(body, sizeof body,
                         "{\"type\":\"urn:grainpack:problem:request-timeout\",\"title\":"

@@ -38,8 +38,16 @@ typedef struct gp_peer_conn {
     struct gp_peer_conn *prev, *next;
 } gp_peer_conn;
 
-/* A new empty table, or NULL when out of memory. */
-gp_peers *gp_peers_new(void);
+/* What the table counts for /metrics, kept by its caller (gp_service) so that the routes
+ * read them without linking this file. */
+typedef struct gp_peer_counts {
+    atomic_long open;        /* connections open (with a record) */
+    atomic_ulong slow_heads; /* connections the watcher closed for a late head */
+} gp_peer_counts;
+
+/* A new empty table counting into *counts (not owned: it must outlive the table), or
+ * NULL when out of memory. */
+gp_peers *gp_peers_new(gp_peer_counts *counts);
 void gp_peers_free(gp_peers *p);
 
 /* A connection from addr opened on socket fd; `limit` is the most connections allowed
@@ -54,10 +62,8 @@ void gp_peers_head_done(gp_peers *p, gp_peer_conn *conn);
 void gp_peers_head_begins(gp_peers *p, gp_peer_conn *conn);
 
 /* Starts the watcher: a head not complete `seconds` after it began gets a 408 problem
- * and its connection is shut down, counted in *closed (not owned: it must outlive p; a
- * counter the routes read without linking this file). Returns 0 or GP_ENOMEM.
- * gp_peers_free stops it. */
-int gp_peers_watch(gp_peers *p, double seconds, atomic_ulong *closed);
+ * and its connection is shut down. Returns 0 or GP_ENOMEM. gp_peers_free stops it. */
+int gp_peers_watch(gp_peers *p, double seconds);
 
 /* The connection closed: its record is freed. NULL is a no-op. */
 void gp_peers_closed(gp_peers *p, gp_peer_conn *conn);

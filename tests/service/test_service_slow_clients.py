@@ -198,14 +198,20 @@ def test_abandoned_polls(c, binary):
                     f"(429) instead of waiting, after {hung_up} others were abandoned")
             hung_up += count
             deadline = time.monotonic() + 30
+            # counted when the wait is released; the place is given back once libmicrohttpd
+            # closes the connection (on a loaded machine, a little later): both awaited,
+            # the probe's own connection the only one left
             while time.monotonic() < deadline:
                 probe = daemon.client()
-                seen = gpd.metric(probe.get("/metrics").body.decode(), "grainpack_http_long_polls_hung_up_total")
+                metrics = probe.get("/metrics").body.decode()
                 probe.close()
-                if seen == hung_up:
+                seen = gpd.metric(metrics, "grainpack_http_long_polls_hung_up_total")
+                still = gpd.metric(metrics, "grainpack_http_connections")
+                if seen == hung_up and still == 1:
                     break
                 time.sleep(0.05)
             c.check(seen == hung_up, f"hang-ups counted: {seen} of {hung_up}")
+            c.check(still == 1, f"{still} connections open after the hang-ups (the probe's only expected)")
         # as many connections at once as the hang-ups gave back, from other addresses
         fresh = [connect(port, f"127.0.0.{6 + k % 4}") for k in range(total - 5)]
         for f in fresh:
