@@ -57,10 +57,10 @@
 #define STARTUP_STOP_SECONDS 10.0
 
 /* A test-only fault (never set in production): the environment variable
- * GRAINPACKD_TEST_STALL_SECONDS makes the first progress report of the first job the
- * daemon runs sleep that long without reading its cancel flag, as a stage that ignores
- * the flag would. The service tests use it to check that the pool replaces such a worker,
- * that a stop stays bounded, and what a restart does with the job. */
+ * GRAINPACKD_TEST_STALL_SECONDS makes the first job the daemon runs sleep that long at
+ * its start without reading its cancel flag, as a stage that ignores the flag would. The
+ * service tests use it to check that the pool replaces such a worker, that a stop stays
+ * bounded, and what a restart does with the job. */
 #define TEST_STALL_ENV "GRAINPACKD_TEST_STALL_SECONDS"
 
 /* When the outcome of a job cannot be stored (disk full, database not writable), the worker
@@ -120,12 +120,6 @@ struct gp_pool {
 static void report_progress(void *ctx, const char *stage, double fraction)
 {
     worker *w = ctx;
-    if (w->pool->stall > 0 && atomic_exchange(&w->pool->stalled, 1) == 0) {
-        struct timespec ts = {(time_t)w->pool->stall,
-                              (long)((w->pool->stall - (double)(time_t)w->pool->stall) * 1e9)};
-        while (nanosleep(&ts, &ts) != 0)
-            ;
-    }
     /* the job's progress: each stage the spec runs has an equal share, in order, so that
      * it only rises; the message names the stage and how far it got */
     int k = 0;
@@ -145,6 +139,21 @@ static void report_progress(void *ctx, const char *stage, double fraction)
         w->last_percent = percent;
         w->last_write = now;
     }
+}
+
+/* The test fault (TEST_STALL_ENV): the first job the daemon runs sleeps at its start,
+ * before the pipeline could read its flag, so that a flag raised at once (a DELETE right
+ * after the job is seen running, a short time limit on a loaded machine) cannot let it
+ * end and leave the fault to the next job. */
+static void test_stall(worker *w, const char *id)
+{
+    gp_pool *pool = w->pool;
+    if (pool->stall <= 0 || atomic_exchange(&pool->stalled, 1) != 0)
+        return;
+    gp_log("job %s: test fault, its worker sleeps %g s without reading its flag", id, pool->stall);
+    struct timespec ts = {(time_t)pool->stall, (long)((pool->stall - (double)(time_t)pool->stall) * 1e9)};
+    while (nanosleep(&ts, &ts) != 0)
+        ;
 }
 
 /* The stages the spec runs, in order, for report_progress. */
@@ -483,6 +492,7 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     memset(&result, 0, sizeof result);
     int rc = gp_spec_parse(spec_text, spec_len, &unlimited, &spec, &err);
     if (rc == 0) {
+        test_stall(w, id);
         plan_stages(w, &spec);
         gp_progress progress = {report_progress, w, &w->cancel};
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
