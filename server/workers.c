@@ -47,6 +47,12 @@
  * saw a job stopped by a 0.2 s limit given up on at a load of 20). */
 #define ABANDON_SECONDS 2.0
 
+/* ... and in any case this many seconds of wall-clock time after its flag: at a load of
+ * 35 on 2 cores, a SCHED_IDLE worker spinning in the issue-18 histogram job took 58 s to
+ * be given 2 s of its own (bench/CANCEL.md); past this bound its job fails and its slot
+ * goes to another worker, whatever the load. */
+#define ABANDON_WALL_SECONDS 20.0
+
 /* At most this many workers given up on, per worker of the pool, still run: beyond, the
  * pool stops replacing them rather than start threads without end (each one that never
  * returns takes what processor time the others leave: they all run at the lowest
@@ -354,7 +360,8 @@ static void *watchdog_main(void *arg)
             else if (w->deadline > 0 && w->deadline < next)
                 next = w->deadline;
             given_up job;
-            if (w->canceled_at > 0 && time_to_stop(w, now) >= ABANDON_SECONDS) {
+            if (w->canceled_at > 0 && (time_to_stop(w, now) >= ABANDON_SECONDS ||
+                                       now - w->canceled_at >= ABANDON_WALL_SECONDS)) {
                 abandon(pool, i, now, &job);
                 pthread_mutex_unlock(&pool->lock);
                 record_given_up(pool, &job);
