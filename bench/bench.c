@@ -1,8 +1,12 @@
 /* bench.c - the packer's benchmark (not a test): the report's four cases (disks, density,
- * fidelity, median time), the level-band option against the report's rule, and a scaling
- * run on the Bagi law from 10^3 to 10^7 disks with disks per second and peak memory.
- * Prints markdown. Usage: grainpack_bench [--quick] [--max-disks N] EXAMPLES_DIR */
+ * fidelity, median time), the level-band option against the report's rule, a scaling run
+ * on the Bagi law from 10^3 to 10^7 disks with disks per second and peak memory, and the
+ * packer's limits (the worst laws it accepts: their speed, and how fast a cancel stops
+ * them). Prints markdown.
+ * Usage: grainpack_bench [--quick] [--max-disks N] [--only SECTION] EXAMPLES_DIR
+ * with SECTION one of cases, sampling, scaling, limits. */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -246,26 +250,133 @@ static void bench_scaling(double max_disks)
     printf("\n");
 }
 
+/* A law of two narrow bins, the small one drawn with probability p_small, in a square. */
+typedef struct two_bins {
+    gp_bin bins[2];
+    gp_distribution dist;
+    gp_domain dom;
+} two_bins;
+
+static void two_bins_init(two_bins *tb, double r_small, double r_large, double p_small, double side)
+{
+    tb->bins[0] = (gp_bin){r_small, 1.05 * r_small, p_small};
+    tb->bins[1] = (gp_bin){r_large / 1.05, r_large, 1.0 - p_small};
+    tb->dist = (gp_distribution){.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = tb->bins};
+    tb->dom = (gp_domain){side, side};
+    if (gp_distribution_prepare(&tb->dist))
+        exit(1);
+}
+
+typedef struct cancel_run {
+    const gp_pack_params *params;
+    gp_cancel_flag flag;
+    int rc;
+    double returned; /* when gp_pack returned */
+} cancel_run;
+
+static void *cancel_thread(void *arg)
+{
+    cancel_run *cr = arg;
+    gp_progress progress = {NULL, NULL, &cr->flag};
+    gp_packing pk;
+    gp_error err;
+    cr->rc = gp_pack(cr->params, &progress, &pk, &err);
+    cr->returned = now();
+    if (cr->rc == 0)
+        gp_packing_free(&pk);
+    return NULL;
+}
+
+/* The worst laws the packer takes, at its radius-ratio cap: disks per second, and the
+ * time from raising the cancel flag to gp_pack's return, after `after` seconds of work. */
+static void bench_limits(int quick)
+{
+    static const struct {
+        const char *label;
+        double r_small, r_large, p_small, side;
+    } laws[] = {
+        {"ratio 10, small 99.999%", 0.1, 1.0, 0.99999, 40},
+        {"ratio 100, half small", 0.01, 1.0, 0.5, 400},
+        {"ratio 100, small 99.9%", 0.01, 1.0, 0.999, 30},
+        {"ratio 100, small 99.999%", 0.01, 1.0, 0.99999, 30},
+    };
+    double after = quick ? 0.2 : 1.0;
+    printf("### The packer's limits: the worst laws it accepts\n\n");
+    printf("Two narrow bins (width 5%%) at the cap of GP_PACK_MAX_RADIUS_RATIO = %g; the cancel flag "
+           "raised after %.1f s of packing (or when the packing ended first).\n\n",
+           GP_PACK_MAX_RADIUS_RATIO, after);
+    printf("| law | domain | disks | time | disks per second | time to stop after cancel |\n");
+    printf("|---|---|---|---|---|---|\n");
+    for (size_t i = 0; i < sizeof laws / sizeof laws[0]; i++) {
+        two_bins tb;
+        two_bins_init(&tb, laws[i].r_small, laws[i].r_large, laws[i].p_small, laws[i].side);
+        gp_joint joint = {GP_JOINT_NONE, 0, 0, 0};
+        gp_pack_params params = {&tb.dom, &tb.dist, &joint, 1, 0, 0};
+        /* a full run for the speed, capped so that the slowest stays within a minute */
+        gp_packing pk;
+        gp_error err;
+        params.max_disks = quick ? 20000 : 200000;
+        double t0 = now();
+        int rc = gp_pack(&params, NULL, &pk, &err);
+        double t = now() - t0;
+        size_t count = rc == 0 ? pk.count : params.max_disks;
+        if (rc == 0)
+            gp_packing_free(&pk);
+        else if (rc != GP_ETOOBIG) {
+            printf("| %s | failed: %s | | | | |\n", laws[i].label, err.message);
+            continue;
+        }
+        params.max_disks = 0;
+        cancel_run cr = {&params, 0, 0, 0.0};
+        atomic_init(&cr.flag, 0);
+        pthread_t th;
+        if (pthread_create(&th, NULL, cancel_thread, &cr))
+            exit(1);
+        struct timespec nap = {(time_t)after, (long)((after - floor(after)) * 1e9)};
+        nanosleep(&nap, NULL);
+        double raised = now();
+        atomic_store(&cr.flag, 1);
+        pthread_join(th, NULL);
+        char stop[64];
+        if (cr.rc == GP_ECANCELED)
+            snprintf(stop, sizeof stop, "%.2f ms", 1e3 * (cr.returned - raised));
+        else
+            snprintf(stop, sizeof stop, "finished first");
+        printf("| %s | %g x %g | %zu%s | %.2f s | %.0f | %s |\n", laws[i].label, laws[i].side,
+               laws[i].side, count, rc == GP_ETOOBIG ? " (capped)" : "", t, (double)count / t, stop);
+        fflush(stdout);
+        free(tb.dist.cdf);
+    }
+    printf("\n");
+}
+
 int main(int argc, char **argv)
 {
     int quick = 0;
     double max_disks = 1e7;
-    const char *dir = NULL;
+    const char *dir = NULL, *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--quick") == 0)
             quick = 1;
         else if (strcmp(argv[i], "--max-disks") == 0 && i + 1 < argc)
             max_disks = atof(argv[++i]);
+        else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
         else
             dir = argv[i];
     }
     if (!dir) {
-        fprintf(stderr, "usage: grainpack_bench [--quick] [--max-disks N] EXAMPLES_DIR\n");
+        fprintf(stderr, "usage: grainpack_bench [--quick] [--max-disks N] [--only SECTION] EXAMPLES_DIR\n");
         return 2;
     }
     print_machine();
-    bench_cases(dir, quick ? 3 : 15, quick ? 5 : 50);
-    bench_report_sampling(dir, quick ? 5 : 50);
-    bench_scaling(quick ? 1e5 : max_disks);
+    if (!only || strcmp(only, "cases") == 0)
+        bench_cases(dir, quick ? 3 : 15, quick ? 5 : 50);
+    if (!only || strcmp(only, "sampling") == 0)
+        bench_report_sampling(dir, quick ? 5 : 50);
+    if (!only || strcmp(only, "scaling") == 0)
+        bench_scaling(quick ? 1e5 : max_disks);
+    if (!only || strcmp(only, "limits") == 0)
+        bench_limits(quick);
     return 0;
 }

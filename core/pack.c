@@ -11,41 +11,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "front.h"
-#include "grainpack/grid.h"
+#include "packer.h"
 
 /* Fraction of the domain a packing is expected to fill: used for the capacity guess and
  * to turn the filled area into a progress fraction. */
 #define FILL_GUESS 0.86
-/* Tries between two progress reports / cancel checks: well under a millisecond. */
-#define PROGRESS_EVERY 2048
 /* Closings a disk may start (as p1) before the segments it starts are frozen instead.
  * A disk of radius R_max ringed by disks of radius R_min has about pi (R_max + R_min) /
  * R_min neighbours, each of which may cost one closing: 64 covers a ratio of 20. With
  * simple loops the cap is never reached (it was not, over 160 runs of the reference
  * cases); it is there so that the loop stays finite whatever rounding does. */
 #define CLOSINGS_PER_DISK 64
-
-typedef struct packer {
-    const gp_pack_params *params;
-    const gp_progress *progress;
-    gp_rng rng;
-    double pending_r, pending_R; /* the drawn radius, kept until it is placed */
-
-    gp_disk *disks;
-    uint32_t *level;    /* per disk (report eq. 6) */
-    uint8_t *closings;  /* per disk: closings it started as p1 */
-    size_t count, capacity;
-    gp_grid grid;
-    front fr;
-
-    int32_t *conflicts; /* scratch for the closing step, room for two at least */
-    size_t conflict_capacity;
-
-    gp_packing *out;
-    gp_error *err;
-    uint64_t work_since_report;
-} packer;
 
 /* ---- radii ---- */
 
@@ -78,9 +54,7 @@ static int grow_disks(packer *pk)
     return 0;
 }
 
-/* Appends the pending radius as a disk at (x, y) with the given level and draws the next
- * radius. Returns its id, or a negative GP_E code. */
-static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
+int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level)
 {
     if (pk->params->max_disks && pk->count >= pk->params->max_disks)
         return gp_error_set(pk->err, GP_ETOOBIG, NULL,
@@ -100,11 +74,7 @@ static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
     return id;
 }
 
-/* Whether a packing disk of radius R centred at (x, y) fits: inside the domain,
- * overlapping no disk but the two it was placed against, and crossing no barrier of the
- * front but the segment it was placed against. *blocker (when not NULL) gets the disk in
- * the way, or GP_GRID_NONE. */
-static int fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
+int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
                 int32_t skip_segment, int32_t *blocker)
 {
     int32_t q = GP_GRID_NONE;
@@ -126,118 +96,6 @@ static int overlaps_disk(const packer *pk, double x, double y, double R, int32_t
 static int front_oom(packer *pk)
 {
     return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the front");
-}
-
-/* ---- the initial front (docs/method.md §3.2) ---- */
-
-static int build_initial_front(packer *pk)
-{
-    const gp_domain *dom = pk->params->domain;
-    enum { N = GP_DOMAIN_CORNERS };
-    double vx[N], vy[N], ex[N], ey[N], nx[N], ny[N];
-    for (int i = 0; i < N; i++)
-        gp_domain_corner(dom, i, &vx[i], &vy[i]);
-    for (int i = 0; i < N; i++) {
-        double dx = vx[(i + 1) % N] - vx[i], dy = vy[(i + 1) % N] - vy[i];
-        double len = sqrt(dx * dx + dy * dy);
-        ex[i] = dx / len;
-        ey[i] = dy / len;
-        nx[i] = -ey[i]; /* inward: the domain is counter-clockwise */
-        ny[i] = ex[i];
-    }
-
-    /* One disk in each corner first, so that every edge knows where it must stop. The
-     * centre at distance R from both edges is v + R (n_prev + n) / (1 + n_prev . n). */
-    int32_t corner_disk[N];
-    for (int i = 0; i < N; i++) {
-        int p = (i + N - 1) % N;
-        double scale = pk->pending_R / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
-        double cx = vx[i] + scale * (nx[p] + nx[i]), cy = vy[i] + scale * (ny[p] + ny[i]);
-        corner_disk[i] = -1;
-        if (fits(pk, cx, cy, pk->pending_R, -1, -1, FRONT_NONE, NULL)) {
-            int32_t id = add_disk(pk, cx, cy, 0);
-            if (id < 0)
-                return id;
-            corner_disk[i] = id;
-        }
-    }
-
-    /* Then along each edge, counter-clockwise: each disk touches the wall and the disks
-     * before it on the edge (two disks touching a wall with radii R, R' have centres
-     * 2 sqrt(R R') apart along it; the new one goes as near the corner as that allows,
-     * which is tangent to the previous disk unless a tiny one sits between two large
-     * ones), until it would leave the domain past the next corner's disk. */
-    size_t loop_len = 0, loop_cap = 256;
-    int32_t *loop = malloc(loop_cap * sizeof *loop);
-    if (!loop)
-        return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
-    int rc = 0;
-    for (int i = 0; i < N && rc == 0; i++) {
-        if (corner_disk[i] < 0)
-            continue;
-        size_t edge_start = loop_len;
-        int32_t prev = corner_disk[i];
-        int p = (i + N - 1) % N;
-        /* a disk larger than the corner's must clear the previous wall too: at the least
-         * it sits where the corner disk would for its own radius */
-        double clear = (nx[p] * ex[i] + ny[p] * ey[i]) / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
-        for (;;) {
-            if (loop_len == loop_cap) {
-                int32_t *grown = realloc(loop, 2 * loop_cap * sizeof *loop);
-                if (!grown) {
-                    rc = gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
-                    break;
-                }
-                loop = grown;
-                loop_cap *= 2;
-            }
-            loop[loop_len++] = prev;
-            double R = pk->pending_R, t = clear * R;
-            double t_prev = (pk->disks[prev].x - vx[i]) * ex[i] + (pk->disks[prev].y - vy[i]) * ey[i];
-            /* only disks within 2 R_max of the last one along the edge can be in the way */
-            for (size_t k = loop_len; k-- > edge_start;) {
-                const gp_disk *dk = &pk->disks[loop[k]];
-                double tk = (dk->x - vx[i]) * ex[i] + (dk->y - vy[i]) * ey[i];
-                if (tk < t_prev - 2.0 * pk->grid.cell)
-                    break;
-                double reach = tk + 2.0 * sqrt(R * dk->R);
-                if (reach > t)
-                    t = reach;
-            }
-            /* any other disk in the way (the last ones of the previous edge, near the
-             * corner) pushes the disk on along the wall, past it; the edge ends when the
-             * disk would leave the domain, at the next corner */
-            double cx, cy;
-            int32_t q;
-            for (;;) {
-                cx = vx[i] + t * ex[i] + R * nx[i];
-                cy = vy[i] + t * ey[i] + R * ny[i];
-                if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
-                    break;
-                q = gp_grid_first_overlap(&pk->grid, pk->disks, cx, cy, R, -1, -1);
-                if (q == GP_GRID_NONE)
-                    break;
-                const gp_disk *dq = &pk->disks[q];
-                double tq = (dq->x - vx[i]) * ex[i] + (dq->y - vy[i]) * ey[i];
-                double hq = (dq->x - vx[i]) * nx[i] + (dq->y - vy[i]) * ny[i];
-                t = tq + sqrt((R + dq->R) * (R + dq->R) - (R - hq) * (R - hq));
-            }
-            if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
-                break;
-            int32_t id = add_disk(pk, cx, cy, 0);
-            if (id < 0) {
-                rc = id;
-                break;
-            }
-            prev = id;
-        }
-    }
-    pk->out->initial_front = pk->count;
-    /* fewer than three disks enclose nothing: the domain holds no more */
-    if (rc == 0 && loop_len >= 3 && front_add_loop(&pk->fr, loop, loop_len))
-        rc = front_oom(pk);
-    free(loop);
-    return rc;
 }
 
 /* ---- the loop (docs/method.md §3.5) ---- */
@@ -293,7 +151,7 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
             return 0;
         }
     int32_t q;
-    int ok = fits(pk, *x, *y, R, a, b, u, &q);
+    int ok = pack_fits(pk, *x, *y, R, a, b, u, &q);
     if (q != GP_GRID_NONE)
         nodes[u].blocker = q;
     return ok;
@@ -314,12 +172,14 @@ static int try_segment(packer *pk, int32_t u, int bridge_gap)
     double x, y;
     int touches_b;
     pk->out->attempts++;
-    pk->work_since_report++;
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
     if (!find_position(pk, u, pk->pending_R, bridge_gap, &x, &y, &touches_b))
         return 0;
     uint32_t la = pk->level[a], lb = pk->level[b];
     /* our definition of report eq. 6: one more than the lower of the two */
-    int32_t c = add_disk(pk, x, y, (la < lb ? la : lb) + 1);
+    int32_t c = pack_add_disk(pk, x, y, (la < lb ? la : lb) + 1);
     if (c < 0)
         return c;
     return front_place(&pk->fr, u, c, touches_b) ? front_oom(pk) : 1;
@@ -398,6 +258,9 @@ static int close_front(packer *pk, int32_t u)
     double x, y;
     int32_t w = FRONT_NONE;
     pk->out->closures++;
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
     if (pk->closings[p1] >= CLOSINGS_PER_DISK) {
         front_freeze(&pk->fr, u);
         pk->out->capped++;
@@ -418,14 +281,17 @@ static int close_front(packer *pk, int32_t u)
     return front_close(&pk->fr, u, w) ? front_oom(pk) : 0;
 }
 
-static int report_progress(packer *pk)
+int pack_check(packer *pk)
 {
-    pk->work_since_report = 0;
+    pk->work = 0;
     const gp_progress *pr = pk->progress;
     if (!pr)
         return 0;
     if (pr->cancel && atomic_load_explicit(pr->cancel, memory_order_relaxed))
         return gp_error_set(pk->err, GP_ECANCELED, NULL, "packing canceled after %zu disks", pk->count);
+    if (++pk->checks < PACK_CHECKS_PER_REPORT)
+        return 0;
+    pk->checks = 0;
     if (pr->report) {
         double expected = FILL_GUESS * gp_domain_area(pk->params->domain);
         double f = pk->out->fill_area / expected;
@@ -438,11 +304,6 @@ static int run_front(packer *pk)
 {
     uint32_t band = pk->params->level_band;
     while (pk->fr.active > 0) {
-        if (pk->work_since_report >= PROGRESS_EVERY) {
-            int rc = report_progress(pk);
-            if (rc)
-                return rc;
-        }
         /* the first segment of the front's level is tried first, whatever it failed for
          * before; then every segment of the level band that has not failed for a radius
          * <= R, lowest level first; and only then is the front closed at the first */
@@ -478,6 +339,33 @@ static int run_front(packer *pk)
     return 0;
 }
 
+gp_pack_law_limit gp_pack_check_law(const gp_domain *domain, const gp_distribution *dist,
+                                    const gp_joint *joint, gp_error *err)
+{
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(dist, &r_min, &r_max);
+    gp_joint_packing_range(joint, r_min, r_max, &R_min, &R_max);
+    if (!(R_max <= GP_PACK_MAX_RADIUS_RATIO * R_min)) {
+        gp_error_set(err, GP_EINVAL, NULL,
+                     "packing radii from %g to %g span a ratio of %.3g, more than the packer's "
+                     "limit of %g: the work to test a position grows with the square of that "
+                     "ratio, so such a law could take unbounded time (docs/method.md §3.7)",
+                     R_min, R_max, R_max / R_min, GP_PACK_MAX_RADIUS_RATIO);
+        return GP_PACK_LAW_RATIO;
+    }
+    double side = domain->width > domain->height ? domain->width : domain->height;
+    if (!(side <= GP_PACK_MAX_SIDE_RADII * R_min)) {
+        gp_error_set(err, GP_EINVAL, NULL,
+                     "the smallest packing radius %g is too small for a domain side of %g "
+                     "(%.3g radii, the limit is %g): disks placed in double precision that far "
+                     "from the origin would overlap by more than the contact tolerance "
+                     "(docs/method.md §3.7)",
+                     R_min, side, side / R_min, GP_PACK_MAX_SIDE_RADII);
+        return GP_PACK_LAW_PRECISION;
+    }
+    return GP_PACK_LAW_OK;
+}
+
 int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
             gp_error *err)
 {
@@ -497,6 +385,14 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
         !(params->domain->height >= 2 * R_max))
         return gp_error_set(err, GP_EINVAL, NULL,
                             "the largest packing disk (R = %g) does not fit in the domain", R_max);
+    if (gp_pack_check_law(params->domain, params->dist, params->joint, err))
+        return GP_EINVAL;
+
+    /* The disks a grid query may test: those with centres in the 3 x 3 cells of side
+     * 2 R_max around the candidate, disjoint and of radius R_min at least, so within the
+     * block grown by R_min: (6 R_max + 2 R_min)^2 / (pi R_min^2) of them at most. */
+    double ratio = R_max / R_min;
+    pk.query_units = 1 + (uint64_t)((6.0 * ratio + 2.0) * (6.0 * ratio + 2.0) / M_PI / PACK_TESTS_PER_UNIT);
 
     /* room for the expected number of disks, so that large runs never copy the arrays */
     double expected = FILL_GUESS * gp_domain_area(params->domain) /
@@ -525,7 +421,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
     }
     if (rc == 0) {
         draw_radius(&pk);
-        rc = build_initial_front(&pk);
+        rc = pack_walls(&pk);
     }
     if (rc == 0)
         rc = run_front(&pk);

@@ -182,6 +182,135 @@ static void test_other_laws_and_joints_hold_every_property(void)
     }
 }
 
+/* Whether packing b is packing a turned by 90 degrees counter-clockwise: a in W x H, b in
+ * H x W, where (x, y) goes to (H - y, x); disk for disk, in the same order, within a
+ * relative 1e-9 (the two are computed apart, in doubles). */
+static int is_turned(const gp_packing *a, const gp_packing *b, double H)
+{
+    if (a->count != b->count)
+        return 0;
+    for (size_t i = 0; i < a->count; i++) {
+        const gp_disk *p = &a->disks[i], *q = &b->disks[i];
+        double tol = 1e-9 * (p->R > 1.0 ? p->R : 1.0) * (H > 1.0 ? H : 1.0);
+        if (fabs(H - p->y - q->x) > tol || fabs(p->x - q->y) > tol || p->R != q->R)
+            return 0;
+    }
+    return 1;
+}
+
+static void test_turned_and_transposed_domains_fill_alike(void)
+{
+    /* A rectangle turned by 90 degrees and the transposed one (mirrored across its
+     * diagonal) are the same rectangle, H x W: the packer must fill it as it fills W x H.
+     * Both turnings are checked: the counts over many seeds agree within noise, whatever
+     * the law and however narrow the strip (a 1 x 10 strip of r = 0.3 once got 2 disks
+     * and the 10 x 1 one 17); and as the walk starts from a longest wall, the packing of
+     * H x W is the turned packing of W x H, disk for disk, for all but rare seeds where
+     * rounding tips one test the other way. */
+    static const struct {
+        const char *label, *law;
+        double W, H;
+    } configs[] = {
+        {"constant r 0.3, 10 x 1", "{\"kind\":\"constant\",\"radius\":0.3}", 10, 1},
+        {"constant r 0.3, 10 x 1.1", "{\"kind\":\"constant\",\"radius\":0.3}", 10, 1.1},
+        {"uniform 0.1-0.3, 10 x 1", "{\"kind\":\"uniform\",\"min\":0.1,\"max\":0.3}", 10, 1},
+        {"uniform 0.1-0.5, 40 x 5", "{\"kind\":\"uniform\",\"min\":0.1,\"max\":0.5}", 40, 5},
+        {"Bagi law, 30 x 8", "{\"kind\":\"uniform\",\"min\":0.06,\"max\":0.42}", 30, 8},
+        {"variable law, 50 x 12",
+         "{\"kind\":\"histogram\",\"bins\":[{\"min\":0.2,\"max\":0.4,\"p\":0.3},{\"min\":0.4,"
+         "\"max\":0.6,\"p\":0.2},{\"min\":0.6,\"max\":0.9,\"p\":0.5}]}", 50, 12},
+    };
+    enum { TURN_SEEDS = 60 };
+    for (size_t i = 0; i < sizeof configs / sizeof configs[0]; i++) {
+        char json[2][512];
+        gp_spec spec[2];
+        for (int t = 0; t < 2; t++) {
+            snprintf(json[t], sizeof json[t], "{\"domain\":{\"width\":%g,\"height\":%g},\"distribution\":%s}",
+                     t ? configs[i].H : configs[i].W, t ? configs[i].W : configs[i].H, configs[i].law);
+            parse(json[t], &spec[t]);
+        }
+        double sum[2] = {0, 0}, sum2[2] = {0, 0};
+        int turned = 0;
+        for (int seed = 1; seed <= TURN_SEEDS; seed++) {
+            gp_packing pk[2];
+            gp_error err;
+            for (int t = 0; t < 2; t++) {
+                gp_pack_params params = {&spec[t].domain, &spec[t].dist, &spec[t].joint, (uint64_t)seed, 0,
+                                         spec[t].level_band};
+                CHECK_MSG(gp_pack(&params, NULL, &pk[t], &err) == 0, "%s: %s", configs[i].label, err.message);
+                sum[t] += (double)pk[t].count;
+                sum2[t] += (double)pk[t].count * (double)pk[t].count;
+            }
+            turned += is_turned(&pk[0], &pk[1], configs[i].H);
+            gp_packing_free(&pk[0]);
+            gp_packing_free(&pk[1]);
+        }
+        double mean[2], var[2];
+        for (int t = 0; t < 2; t++) {
+            mean[t] = sum[t] / TURN_SEEDS;
+            var[t] = sum2[t] / TURN_SEEDS - mean[t] * mean[t];
+        }
+        /* within 4 standard errors of the difference; half a disk for laws without noise */
+        double se = sqrt((var[0] + var[1]) / TURN_SEEDS);
+        CHECK_MSG(fabs(mean[0] - mean[1]) <= 4.0 * se + 0.5, "%s: %.1f disks, turned %.1f (se %.2f)",
+                  configs[i].label, mean[0], mean[1], se);
+        CHECK_MSG(turned >= TURN_SEEDS * 9 / 10, "%s: only %d of %d seeds give the turned packing",
+                  configs[i].label, turned, TURN_SEEDS);
+        fprintf(stderr, "  %-28s %.1f disks, turned %.1f; the turned packing on %d of %d seeds\n",
+                configs[i].label, mean[0], mean[1], turned, TURN_SEEDS);
+        gp_spec_free(&spec[0]);
+        gp_spec_free(&spec[1]);
+    }
+}
+
+static void test_narrow_strip_is_filled_along_its_length(void)
+{
+    /* 1 x 10 with r = 0.3: a row of 17 disks along a long wall (the report's rule leaves
+     * no room for a second row), as in 10 x 1; once 2 disks, the corners only */
+    for (int t = 0; t < 2; t++) {
+        gp_spec spec;
+        parse(t ? "{\"domain\":{\"width\":1,\"height\":10},\"distribution\":{\"kind\":\"constant\",\"radius\":0.3}}"
+                : "{\"domain\":{\"width\":10,\"height\":1},\"distribution\":{\"kind\":\"constant\",\"radius\":0.3}}",
+              &spec);
+        gp_pack_params params = {&spec.domain, &spec.dist, &spec.joint, 1, 0, 0};
+        gp_packing pk;
+        gp_error err;
+        CHECK(gp_pack(&params, NULL, &pk, &err) == 0);
+        CHECK_MSG(pk.count == 17, "%s: %zu disks", t ? "1 x 10" : "10 x 1", pk.count);
+        double worst;
+        CHECK(count_overlaps(pk.disks, pk.count, &worst) == 0);
+        CHECK(count_outside(pk.disks, pk.count, &spec.domain) == 0);
+        gp_packing_free(&pk);
+        gp_spec_free(&spec);
+    }
+}
+
+static void test_laws_beyond_the_limits_are_refused_not_packed(void)
+{
+    /* the issue's job that never ended: radii 1e-6 and 1 in 100 x 100. gp_pack refuses it
+     * itself (for callers that skip the spec), saying which limit and why */
+    gp_bin bins[2] = {{1e-6, 2e-6, 0.5}, {1.0, 1.1, 0.5}};
+    gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
+    CHECK(gp_distribution_prepare(&dist) == 0);
+    gp_domain dom = {100, 100};
+    gp_pack_params params = {&dom, &dist, NULL, 1, 0, 0};
+    gp_packing pk;
+    gp_error err;
+    CHECK(gp_pack(&params, NULL, &pk, &err) == GP_EINVAL);
+    CHECK(strstr(err.message, "more than the packer's limit of 100") != NULL);
+    CHECK(pk.disks == NULL && pk.count == 0);
+    /* within the ratio, but too small for the domain's precision */
+    bins[0] = (gp_bin){0.02, 0.021, 0.5};
+    bins[1] = (gp_bin){1.0, 1.1, 0.5};
+    gp_domain strip = {30000, 2.5};
+    params.domain = &strip;
+    CHECK(gp_pack(&params, NULL, &pk, &err) == GP_EINVAL);
+    CHECK(strstr(err.message, "too small for a domain side of 30000") != NULL);
+    CHECK(gp_pack_check_law(&dom, &dist, NULL, &err) == GP_PACK_LAW_OK);
+    CHECK(gp_pack_check_law(&strip, &dist, NULL, &err) == GP_PACK_LAW_PRECISION);
+    free(dist.cdf);
+}
+
 static void test_cap_stops_the_packing_with_a_clear_error(void)
 {
     gp_spec spec;
@@ -224,13 +353,64 @@ static void test_progress_rises_to_one_and_cancel_stops_the_loop(void)
     gp_spec_free(&spec);
 }
 
+typedef struct cancel_on_report {
+    gp_cancel_flag flag;
+    int reports;
+    double fraction; /* at the first report */
+} cancel_on_report;
+
+static void raise_cancel(void *ctx, const char *stage, double fraction)
+{
+    (void)stage;
+    (void)fraction;
+    cancel_on_report *c = ctx;
+    if (c->reports++ == 0)
+        c->fraction = fraction;
+    atomic_store(&c->flag, 1);
+}
+
+static void test_cancel_stops_the_worst_law_at_the_next_check(void)
+{
+    /* The slowest law the packer accepts: radii at the ratio cap, nearly all of them the
+     * smallest, so that every grid query tests thousands of disks. A cancel raised at the
+     * first progress report must end gp_pack at the next check, before any further report
+     * (reports come once per PACK_CHECKS_PER_REPORT checks), whatever the loop it is in:
+     * the checks are counted in units of worst-case work, not in placements. The time this
+     * takes is measured by bench/ (bench/RESULTS.md, the packer's limits). */
+    gp_bin bins[2] = {{0.01, 0.0105, 0.99999}, {0.95, 1.0, 0.00001}};
+    gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
+    CHECK(gp_distribution_prepare(&dist) == 0);
+    for (int walls_only = 0; walls_only < 2; walls_only++) {
+        /* a domain whose walls alone hold 300 000 disks, where the first report must come
+         * from the walk along the walls (their first ~40 disks, not their end at 1% of the
+         * fill), and one where it comes from the front */
+        gp_domain dom = walls_only ? (gp_domain){3000, 3} : (gp_domain){30, 30};
+        gp_pack_params params = {&dom, &dist, NULL, 1, 0, 0};
+        cancel_on_report c = {0, 0, 0.0};
+        atomic_init(&c.flag, 0);
+        gp_progress progress = {raise_cancel, &c, &c.flag};
+        gp_packing pk;
+        gp_error err;
+        CHECK(gp_pack(&params, &progress, &pk, &err) == GP_ECANCELED);
+        CHECK_MSG(c.reports == 1, "%d reports", c.reports);
+        if (walls_only)
+            CHECK_MSG(c.fraction < 1e-3, "first report at %g of the fill", c.fraction);
+        CHECK(strstr(err.message, "canceled") != NULL);
+    }
+    free(dist.cdf);
+}
+
 int main(void)
 {
     RUN(test_fixed_case_reproduces_the_report_count);
     RUN(test_reference_cases_hold_every_property_over_200_seeds);
     RUN(test_level_bands_keep_every_property);
     RUN(test_other_laws_and_joints_hold_every_property);
+    RUN(test_turned_and_transposed_domains_fill_alike);
+    RUN(test_narrow_strip_is_filled_along_its_length);
+    RUN(test_laws_beyond_the_limits_are_refused_not_packed);
     RUN(test_cap_stops_the_packing_with_a_clear_error);
+    RUN(test_cancel_stops_the_worst_law_at_the_next_check);
     RUN(test_progress_rises_to_one_and_cancel_stops_the_loop);
     return check_status();
 }

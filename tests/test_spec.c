@@ -119,6 +119,22 @@ static const error_case errors[] = {
     {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"constant\",\"radius\":2},\"joint\":{\"law\":\"power\",\"k\":1,\"exponent\":1e300}}",
      GP_EINVAL, "/joint", "non-finite"},
     {"{\"domain\":{\"width\":1e5,\"height\":1e5}," CONST "}", GP_ETOOBIG, "/domain", "more than the limit of 20000000"},
+    /* laws the packer cannot pack in bounded time or to the contact tolerance
+     * (docs/method.md §3.7): the pointer names the smallest radius, or the joint when the
+     * grain radii alone are within the ratio */
+    {"{\"domain\":{\"width\":100,\"height\":100},\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1e-06,"
+     "\"max\":2e-06,\"p\":0.5},{\"min\":1,\"max\":1.1,\"p\":0.5}]}}",
+     GP_EINVAL, "/distribution/bins/0/min", "span a ratio of 1.1e+06, more than the packer's limit of 100"},
+    {"{\"domain\":{\"width\":100,\"height\":100},\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1e-03,"
+     "\"max\":2e-03,\"p\":0},{\"min\":0.005,\"max\":0.01,\"p\":0.5},{\"min\":1,\"max\":1.1,\"p\":0.5}]}}",
+     GP_EINVAL, "/distribution/bins/1/min", "span a ratio of 220"},
+    {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"uniform\",\"min\":0.004,\"max\":0.5}}",
+     GP_EINVAL, "/distribution/min", "the work to test a position grows with the square"},
+    {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"uniform\",\"min\":0.01,\"max\":0.5},"
+     "\"joint\":{\"law\":\"power\",\"k\":10,\"exponent\":2}}",
+     GP_EINVAL, "/joint", "more than the packer's limit of 100"},
+    {"{\"domain\":{\"width\":20000,\"height\":1},\"distribution\":{\"kind\":\"constant\",\"radius\":0.01}}",
+     GP_EINVAL, "/distribution/radius", "too small for a domain side of 20000 (2e+06 radii, the limit is 1e+06)"},
     {"{\"domain\":{\"width\":5,\"height\":5}," CONST ",\"domain\":{\"width\":6,\"height\":6}}", GP_EPARSE, "", "duplicate"},
     {"{" DOM "," CONST ",\"balance\":[]}", GP_EINVAL, "/balance", "must be an object, got an array"},
     {"{" DOM "," CONST ",\"balance\":{}}", GP_EINVAL, "/balance/method", "missing; expected one of none, laplacian, relocation"},
@@ -207,6 +223,26 @@ static void test_caps_are_configurable(void)
     gp_spec_limits small = {.max_disks = 1000};
     CHECK(gp_spec_parse(json, strlen(json), &small, &s, &err) == GP_ETOOBIG);
     CHECK(strstr(err.message, "1000") != NULL);
+    /* the cap holds against the bound, not the mean: about 12000 disks expected, but the
+     * mean disk area is carried by rare large disks, and with few of them drawn the small
+     * ones number up to ~76000 (the domain's area over theirs) */
+    const char *rare_large = "{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":"
+                             "\"histogram\",\"bins\":[{\"min\":0.02,\"max\":0.021,\"p\":0.9995},{\"min\":1.9,"
+                             "\"max\":2,\"p\":0.0005}]}}";
+    gp_spec_limits fifty_thousand = {.max_disks = 50000};
+    CHECK(gp_spec_parse(rare_large, strlen(rare_large), &fifty_thousand, &s, &err) == GP_ETOOBIG);
+    CHECK_STR(err.pointer, "/domain");
+    CHECK_MSG(strstr(err.message, "about 1.23e+04 disks expected and up to 7.96e+04 possible") != NULL,
+              "%s", err.message);
+    gp_spec_limits hundred_thousand = {.max_disks = 100000};
+    CHECK(gp_spec_parse(rare_large, strlen(rare_large), &hundred_thousand, &s, &err) == 0);
+    /* the bound sits above the plain estimate, at the domain's area over the mean disk area
+     * or more, and at most at its area over the smallest disk's (no packing of disjoint
+     * disks covers more than the domain) */
+    double bound = gp_spec_disk_bound(&s.domain, &s.dist, &s.joint);
+    CHECK(bound >= 100.0 / (M_PI * gp_distribution_mean_packing_r2(&s.dist, &s.joint)));
+    CHECK(bound > s.expected_disks && bound <= ceil(100.0 / (M_PI * 0.02 * 0.02)));
+    gp_spec_free(&s);
     gp_spec_limits few_bins = {.max_bins = 1};
     const char *two = "{" DOM ",\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1,\"max\":2,"
                       "\"p\":0.5},{\"min\":2,\"max\":3,\"p\":0.5}]}}";

@@ -58,6 +58,9 @@ void gp_distribution_support(const gp_distribution *dist, double *r_min, double 
 /* The expected value of (r + j(r))^2: the mean packing-disk area divided by pi. */
 double gp_distribution_mean_packing_r2(const gp_distribution *dist, const gp_joint *joint);
 
+/* The expected value of (r + j(r))^k, the k-th moment of the packing radius. */
+double gp_distribution_packing_moment(const gp_distribution *dist, const gp_joint *joint, int k);
+
 /* The bins achieved radii are reported against: the histogram's own, ten equal bins for
  * the uniform law, one degenerate bin for a constant radius. Writes at most `cap` bins to
  * `out` and returns how many there are. */

@@ -74,6 +74,12 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
 double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
                               const gp_joint *joint);
 
+/* A number of disks no packing of the law in the domain exceeds but with a chance below
+ * 1e-9: the cap is checked against it, so that a law whose mean disk area is carried by a
+ * few large disks cannot pass the cap on its mean and then pack far more small ones. */
+double gp_spec_disk_bound(const gp_domain *domain, const gp_distribution *dist,
+                          const gp_joint *joint);
+
 /* Frees what the spec owns and zeroes it. */
 void gp_spec_free(gp_spec *spec);
 
