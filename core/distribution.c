@@ -104,6 +104,29 @@ static double mean_pow_on_interval(const gp_joint *joint, double a, double b, in
     return sum * h / 3.0 / (b - a);
 }
 
+double gp_distribution_quantile(const gp_distribution *dist, double q)
+{
+    q = q < 0.0 ? 0.0 : (q > 1.0 ? 1.0 : q);
+    switch (dist->kind) {
+    case GP_DIST_CONSTANT: return dist->radius;
+    case GP_DIST_UNIFORM: return dist->min + q * (dist->max - dist->min);
+    case GP_DIST_HISTOGRAM: {
+        double below = 0.0, r = 0.0;
+        for (size_t i = 0; i < dist->nbins; i++) {
+            const gp_bin *b = &dist->bins[i];
+            if (!(b->p > 0.0))
+                continue;
+            r = b->max;
+            if (below + b->p >= q)
+                return b->min + (q - below) / b->p * (b->max - b->min);
+            below += b->p;
+        }
+        return r;
+    }
+    }
+    return 0.0;
+}
+
 double gp_distribution_packing_moment(const gp_distribution *dist, const gp_joint *joint, int k)
 {
     switch (dist->kind) {

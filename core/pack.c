@@ -124,6 +124,7 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     front_node *nodes = pk->fr.nodes;
     const front_node *n = &nodes[u];
     int32_t a = n->disk, b = nodes[n->next].disk;
+    pk->blocked = -1;
     const gp_disk *da = &pk->disks[a], *db = &pk->disks[b];
     /* docs/method.md §3.1 with the segment's direction and length computed once per segment */
     double ra = da->R + R, rb = db->R + R, d = n->length;
@@ -147,14 +148,30 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     for (int i = 0; i < 3; i++)
         if (likely[i] >= 0 && likely[i] != a && likely[i] != b &&
             overlaps_disk(pk, *x, *y, R, likely[i])) {
-            nodes[u].blocker = likely[i];
+            nodes[u].blocker = pk->blocked = likely[i];
             return 0;
         }
     int32_t q;
     int ok = pack_fits(pk, *x, *y, R, a, b, u, &q);
+    pk->blocked = q;
     if (q != GP_GRID_NONE)
         nodes[u].blocker = q;
     return ok;
+}
+
+/* Records that node u's segment did not take radius R (find_position just said so): a
+ * disk in the way gives the limit from which no radius fits there, which spares the
+ * front trying the segment again for each radius above it; without one (a wall, a
+ * barrier), R itself is the limit. */
+static void mark_failed(packer *pk, int32_t u, double R)
+{
+    double limit = R;
+    if (pk->blocked >= 0) {
+        const front_node *n = &pk->fr.nodes[u];
+        limit = pack_fit_limit(&pk->disks[n->disk], &pk->disks[pk->fr.nodes[n->next].disk],
+                               n->length, n->ux, n->uy, &pk->disks[pk->blocked], pk->R_min, R);
+    }
+    front_mark_failed(&pk->fr, u, limit);
 }
 
 /* Whether node u's segment is wider than a disk of radius R can bridge. */
@@ -300,30 +317,73 @@ int pack_check(packer *pk)
     return 0;
 }
 
+/* Tries the pending radius on the segments of levels from..to that have not failed for
+ * it, best fit first in each level (front_next_eligible), until one takes it. Returns 1
+ * if placed, 0 if not, or a GP_E code. */
+static int try_levels(packer *pk, uint32_t from, uint32_t to)
+{
+    for (uint32_t level = from; level <= to; level++) {
+        int32_t s;
+        while ((s = front_next_eligible(&pk->fr, level, pk->pending_R)) != FRONT_NONE) {
+            int placed = try_segment(pk, s, 0);
+            if (placed)
+                return placed;
+            mark_failed(pk, s, pk->pending_R);
+        }
+    }
+    return 0;
+}
+
+/* Whether the pocket at node u's segment, which just failed the pending radius, would
+ * take a disk of radius R_alive: then it is worth waiting for one. 1, 0 or a GP_E code. */
+static int pocket_alive(packer *pk, int32_t u)
+{
+    if (!(pk->fr.nodes[u].fail_R > pk->R_alive))
+        return 0; /* its limit is already below */
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
+    double x, y;
+    int touches_b;
+    if (find_position(pk, u, pk->R_alive, 0, &x, &y, &touches_b))
+        return 1;
+    mark_failed(pk, u, pk->R_alive);
+    return 0;
+}
+
+/* The loop of docs/method.md §3.5. The first segment of the front's level is tried first,
+ * whatever it failed for before; then every segment of the level band that has not
+ * failed for a radius <= R, lowest level first; under the waiting rule, when the first
+ * segment's pocket would take a radius of the law's alive quantile, the radius climbs up
+ * to pk->wait levels more; only then is the front closed at the first segment.
+ *
+ * Work per placed disk (docs/method.md §3.7): every pass of this loop tests the first
+ * segment, then places a disk, or closes or freezes the first segment. A closing is
+ * counted against its p1 (at most CLOSINGS_PER_DISK each) and a freeze takes a segment
+ * off for good, and each placement or closing makes at most two segments: so passes,
+ * segments and closings are all O(disks). Every other test either places the disk or
+ * lowers a segment's failure class (FRONT_FAIL_CLASSES of them), or tests the alive
+ * radius once per pass; each test is one grid query of at most (6 rho + 2)^2 / pi disks,
+ * rho = R_max / R_min <= GP_PACK_MAX_RADIUS_RATIO. */
 static int run_front(packer *pk)
 {
-    uint32_t band = pk->params->level_band;
     while (pk->fr.active > 0) {
-        /* the first segment of the front's level is tried first, whatever it failed for
-         * before; then every segment of the level band that has not failed for a radius
-         * <= R, lowest level first; and only then is the front closed at the first */
         uint32_t low = front_low_level(&pk->fr);
         int32_t first = front_top(&pk->fr, low);
         int placed = try_segment(pk, first, 0);
         if (placed < 0)
             return placed;
-        if (!placed)
-            front_mark_failed(&pk->fr, first, pk->pending_R);
-        for (uint32_t level = low; level <= low + band && !placed; level++) {
-            int32_t s;
-            while (!placed && (s = front_next_eligible(&pk->fr, level, pk->pending_R)) != FRONT_NONE) {
-                placed = try_segment(pk, s, 0);
-                if (placed < 0)
-                    return placed;
-                if (!placed)
-                    front_mark_failed(&pk->fr, s, pk->pending_R);
-            }
+        if (!placed) {
+            mark_failed(pk, first, pk->pending_R);
+            placed = try_levels(pk, low, low + pk->band);
         }
+        if (!placed && pk->wait) {
+            placed = pocket_alive(pk, first);
+            if (placed > 0)
+                placed = try_levels(pk, low + pk->band + 1, low + pk->band + pk->wait);
+        }
+        if (placed < 0)
+            return placed;
         if (!placed && too_wide(pk, first, pk->pending_R)) {
             /* a gap wider than the radius is filled from one end before it is given up */
             placed = try_segment(pk, first, 1);
@@ -366,6 +426,41 @@ gp_pack_law_limit gp_pack_check_law(const gp_domain *domain, const gp_distributi
     return GP_PACK_LAW_OK;
 }
 
+/* Sets the packer's rule from params (running the pilots for the default) and records it
+ * in the output. Returns 0 or a GP_E code with err set. */
+static int set_rule(packer *pk, double R_min)
+{
+    const gp_pack_params *params = pk->params;
+    gp_packing *out = pk->out;
+    out->rule = params->rule == GP_FRONT_LEVEL_BAND ? GP_FRONT_LEVEL_BAND : GP_FRONT_WAIT;
+    pk->R_min = R_min;
+    if (params->rule == GP_FRONT_LEVEL_BAND) {
+        pk->band = params->level_band;
+        return 0;
+    }
+    out->wait_levels = params->wait_levels;
+    out->alive_quantile = params->alive_quantile;
+    if (params->rule == GP_FRONT_DEFAULT) {
+        int rc = gp_pack_default_rule(params->dist, params->joint, pk->progress, &out->wait_levels,
+                                      &out->alive_quantile, pk->err);
+        if (rc)
+            return rc;
+    } else if (params->rule != GP_FRONT_WAIT || out->wait_levels < 1 ||
+               out->wait_levels > GP_PACK_MAX_WAIT_LEVELS || !(out->alive_quantile >= 0.0) ||
+               !(out->alive_quantile < 1.0)) {
+        return gp_error_set(pk->err, GP_EINVAL, NULL,
+                            "the waiting rule needs 1 to %d levels and a quantile in [0, 1), got "
+                            "%u and %g",
+                            GP_PACK_MAX_WAIT_LEVELS, out->wait_levels, out->alive_quantile);
+    }
+    pk->wait = out->wait_levels;
+    /* the smallest radius for quantile 0, whatever the joint does to the law's ends */
+    double r = gp_distribution_quantile(params->dist, out->alive_quantile);
+    double R = gp_joint_packing_radius(params->joint, r);
+    pk->R_alive = out->alive_quantile > 0.0 && R > R_min ? R : R_min;
+    return 0;
+}
+
 int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packing *out,
             gp_error *err)
 {
@@ -387,6 +482,11 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
                             "the largest packing disk (R = %g) does not fit in the domain", R_max);
     if (gp_pack_check_law(params->domain, params->dist, params->joint, err))
         return GP_EINVAL;
+    int rc = set_rule(&pk, R_min);
+    if (rc) {
+        memset(out, 0, sizeof *out);
+        return rc;
+    }
 
     /* The disks a grid query may test: those with centres in the 3 x 3 cells of side
      * 2 R_max around the candidate, disjoint and of radius R_min at least, so within the
@@ -402,7 +502,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
         capacity = params->max_disks + 1;
 
     /* the grid has about one cell per expected disk or fewer (cells are 2 R_max wide) */
-    int rc = gp_grid_init(&pk.grid, params->domain, R_max, capacity, (size_t)(4.0 * expected) + 1024);
+    rc = gp_grid_init(&pk.grid, params->domain, R_max, capacity, (size_t)(4.0 * expected) + 1024);
     if (rc == GP_ETOOBIG)
         gp_error_set(err, rc, NULL, "the bucket grid would be too large for this domain");
     else if (rc)

@@ -41,6 +41,12 @@ typedef struct packer {
     uint64_t work;      /* units of work since the last check */
     uint64_t query_units; /* units a grid query counts for (see PACK_TESTS_PER_UNIT) */
     uint32_t checks;    /* cancel checks since the last progress report */
+
+    /* the front's rule (gp_front_rule): the level band, and for the waiting rule the
+     * levels a held radius may climb and the radius a waiting pocket must take */
+    uint32_t band, wait;
+    double R_min, R_alive;
+    int32_t blocked;    /* the disk in the way of the last position tested, or -1 */
 } packer;
 
 /* Reads the cancel flag and now and then reports progress: 0, or GP_ECANCELED with err
@@ -65,6 +71,13 @@ int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level);
  * *blocker (when not NULL) gets the disk in the way, or GP_GRID_NONE. */
 int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
               int32_t skip_segment, int32_t *blocker);
+
+/* The packing radius from which on the disk tangent to a and b (d apart, unit vector
+ * (ux, uy) from a to b; the disk on the left) overlaps q, given that it does at R_hi: a
+ * value in [R_lo, R_hi], R_lo when q is in the way of every radius from R_lo, R_hi when
+ * the limit is not known (docs/method.md §3.5). */
+double pack_fit_limit(const gp_disk *a, const gp_disk *b, double d, double ux, double uy,
+                      const gp_disk *q, double R_lo, double R_hi);
 
 /* Lays the initial front along the walls (docs/method.md §3.2) and hands its loop to the
  * front. Returns 0 or a GP_E code with err set. */

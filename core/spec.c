@@ -305,7 +305,8 @@ static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_
     return 0;
 }
 
-static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band)
+static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band,
+                       int *band_set)
 {
     char ptr[GP_ERROR_POINTER_MAX], band_ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
@@ -328,6 +329,7 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
         return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %lld",
                             GP_SPEC_MAX_LEVEL_BAND, (long long)n);
     *band = (uint32_t)n;
+    *band_set = 1;
     return 0;
 }
 
@@ -598,7 +600,7 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = parse_seed(v, inputs, base, &spec->seed)) ||
-        (rc = parse_front(v, inputs, base, &spec->level_band)) ||
+        (rc = parse_front(v, inputs, base, &spec->level_band, &spec->level_band_set)) ||
         (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
         (rc = parse_picture(v, inputs, base, spec)) || (rc = check_whole(v, base, spec)))
         return rc;
@@ -668,6 +670,20 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
         rc = gp_spec_parse(text, len, limits, spec, err);
     free(text);
     return rc;
+}
+
+gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks)
+{
+    gp_pack_params params = {
+        .domain = &spec->domain,
+        .dist = &spec->dist,
+        .joint = &spec->joint,
+        .seed = spec->seed,
+        .max_disks = max_disks,
+        .level_band = spec->level_band,
+        .rule = spec->level_band_set ? GP_FRONT_LEVEL_BAND : GP_FRONT_DEFAULT,
+    };
+    return params;
 }
 
 void gp_spec_free(gp_spec *spec)

@@ -25,14 +25,46 @@ typedef struct config_summary {
     size_t min_count, max_count;
 } config_summary;
 
-/* Packs `spec` for seeds 1..seeds with the given level band and checks every property;
- * returns a summary for the log. */
-static config_summary check_config(const char *label, gp_spec *spec, int seeds, uint32_t band,
-                                   int check_fidelity)
+/* The packer's parameters for the spec with the default rule made explicit: the pilots
+ * of gp_pack_default_rule run once, not once per seed (test_default_rule_is_the_pilots_
+ * choice checks that this is what GP_FRONT_DEFAULT does). */
+static gp_pack_params default_params(const gp_spec *spec)
+{
+    gp_pack_params params = gp_spec_pack_params(spec, 0);
+    gp_error err;
+    CHECK(gp_pack_default_rule(&spec->dist, &spec->joint, NULL, &params.wait_levels,
+                               &params.alive_quantile, &err) == 0);
+    params.rule = GP_FRONT_WAIT;
+    return params;
+}
+
+/* The report's level rule with a level band. */
+static gp_pack_params band_params(const gp_spec *spec, uint32_t band)
+{
+    gp_pack_params params = gp_spec_pack_params(spec, 0);
+    params.rule = GP_FRONT_LEVEL_BAND;
+    params.level_band = band;
+    return params;
+}
+
+static const char *rule_name(const gp_pack_params *p, char *buf, size_t size)
+{
+    if (p->rule == GP_FRONT_LEVEL_BAND)
+        snprintf(buf, size, "band %u", p->level_band);
+    else
+        snprintf(buf, size, "wait %u/q%.2g", p->wait_levels, p->alive_quantile);
+    return buf;
+}
+
+/* Packs with `base` for seeds 1..seeds and checks every property; returns a summary for
+ * the log. */
+static config_summary check_config(const char *label, const gp_spec *spec, int seeds,
+                                   gp_pack_params base, int check_fidelity)
 {
     config_summary sum = {1.0, 0.0, 0.0, -1.0, 0.0, (size_t)-1, 0};
     for (int seed = 1; seed <= seeds; seed++) {
-        gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, (uint64_t)seed, 0, band};
+        gp_pack_params params = base;
+        params.seed = (uint64_t)seed;
         gp_packing pk;
         gp_error err;
         int rc = gp_pack(&params, NULL, &pk, &err);
@@ -86,41 +118,112 @@ static config_summary check_config(const char *label, gp_spec *spec, int seeds, 
         gp_pack_stats_free(&st);
         gp_packing_free(&pk);
     }
+    char rule[48];
     fprintf(stderr,
-            "  %-28s band %u, %3d seeds: %zu..%zu disks, density %.4f..%.4f (mean %.4f), "
+            "  %-28s %-12s %3d seeds: %zu..%zu disks, density %.4f..%.4f (mean %.4f), "
             "max |z| %.2f, closest pair %.2e of R1+R2 apart\n",
-            label, band, seeds, sum.min_count, sum.max_count, sum.min_density, sum.max_density,
-            sum.mean_density, sum.max_abs_z, -sum.worst_overlap);
+            label, rule_name(&base, rule, sizeof rule), seeds, sum.min_count, sum.max_count,
+            sum.min_density, sum.max_density, sum.mean_density, sum.max_abs_z, -sum.worst_overlap);
     return sum;
 }
 
 static void test_reference_cases_hold_every_property_over_200_seeds(void)
 {
-    /* Floors on the packing density of every seed, about 0.01 under the lowest measured
-     * over these 200 seeds (fixed 0.8762, variable 0.773, iron 0.770, Bagi 0.791): a run
-     * that leaves a wall unfilled or lets the front give up drops far below them. */
+    /* The default rule on the report's cases, 200 seeds each: no overlap, every bin
+     * within 4 standard errors, and floors on the density of every seed, about 0.01
+     * under the lowest measured over these 200 seeds (fixed 0.8762, variable 0.810, iron
+     * 0.775, Bagi 0.866), and on the mean, 0.003 under what was measured (variable 0.822,
+     * iron 0.788, Bagi 0.867): a run that leaves a wall unfilled or lets the front give up
+     * drops far below the first, a rule that packs looser than this one below the second. */
     static const struct {
         const char *name;
-        double floor;
-    } cases[] = {{"fixed", 0.876}, {"variable", 0.76}, {"iron", 0.76}, {"bagi", 0.78}};
+        double floor, mean_floor;
+    } cases[] = {{"fixed", 0.876, 0.876}, {"variable", 0.80, 0.819}, {"iron", 0.765, 0.785},
+                 {"bagi", 0.856, 0.864}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         gp_spec spec;
         load_example(cases[i].name, &spec);
-        config_summary s = check_config(cases[i].name, &spec, SEEDS, spec.level_band, 1);
+        config_summary s = check_config(cases[i].name, &spec, SEEDS, default_params(&spec), 1);
         CHECK_MSG(s.min_density >= cases[i].floor, "%s: a seed reached only %.4f", cases[i].name,
                   s.min_density);
+        CHECK_MSG(s.mean_density >= cases[i].mean_floor, "%s: mean density %.4f", cases[i].name,
+                  s.mean_density);
         gp_spec_free(&spec);
     }
 }
 
+static void test_default_specs_reach_the_aimed_densities(void)
+{
+    /* The example files as a user runs them (seed 1, no "front"): the densities issue 12
+     * aimed at, the fixed case still the report's 2789 disks / 0.8762 */
+    static const struct {
+        const char *name;
+        double floor;
+    } cases[] = {{"fixed", 0.8762}, {"variable", 0.82}, {"iron", 0.79}, {"bagi", 0.86}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        gp_spec spec;
+        load_example(cases[i].name, &spec);
+        CHECK(!spec.level_band_set);
+        gp_pack_params params = gp_spec_pack_params(&spec, 0);
+        gp_packing pk;
+        gp_error err;
+        CHECK(gp_pack(&params, NULL, &pk, &err) == 0);
+        double density = pk.fill_area / gp_domain_area(&spec.domain);
+        CHECK_MSG(density >= cases[i].floor - 5e-5, "%s: %zu disks, density %.4f", cases[i].name,
+                  pk.count, density);
+        if (i == 0)
+            CHECK_MSG(pk.count == 2789, "fixed: %zu disks", pk.count);
+        fprintf(stderr, "  %-9s default: %zu disks, density %.4f (wait %u, quantile %g)\n",
+                cases[i].name, pk.count, density, pk.wait_levels, pk.alive_quantile);
+        gp_packing_free(&pk);
+        gp_spec_free(&spec);
+    }
+}
+
+static void test_default_rule_is_the_pilots_choice(void)
+{
+    /* GP_FRONT_DEFAULT is the waiting rule with gp_pack_default_rule's parameters: the
+     * same disks, and the parameters reported */
+    static const char *const cases[] = {"variable", "iron"};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        gp_spec spec;
+        load_example(cases[i], &spec);
+        gp_pack_params def = gp_spec_pack_params(&spec, 0), explicit_rule = default_params(&spec);
+        CHECK(def.rule == GP_FRONT_DEFAULT);
+        for (uint64_t seed = 1; seed <= 3; seed++) {
+            def.seed = explicit_rule.seed = seed;
+            gp_packing a, b;
+            gp_error err;
+            CHECK(gp_pack(&def, NULL, &a, &err) == 0 && gp_pack(&explicit_rule, NULL, &b, &err) == 0);
+            CHECK(a.rule == GP_FRONT_WAIT && a.wait_levels == explicit_rule.wait_levels &&
+                  a.alive_quantile == explicit_rule.alive_quantile);
+            CHECK(a.count == b.count && memcmp(a.disks, b.disks, a.count * sizeof *a.disks) == 0);
+            gp_packing_free(&a);
+            gp_packing_free(&b);
+        }
+        gp_spec_free(&spec);
+    }
+    /* a law of one radius has nothing to choose: no pilot, the first candidate */
+    gp_distribution one = {.kind = GP_DIST_CONSTANT, .radius = 0.5};
+    uint32_t wait = 0;
+    double q = -1.0;
+    gp_error err;
+    CHECK(gp_pack_default_rule(&one, NULL, NULL, &wait, &q, &err) == 0);
+    CHECK(wait == 4 && q == 0.0);
+}
+
 static void test_fixed_case_reproduces_the_report_count(void)
 {
-    /* the report's fixed-radius structure: 2789 disks, density 0.8762 */
+    /* the report's fixed-radius structure: 2789 disks, density 0.8762, whatever the rule */
     gp_spec spec;
     load_example("fixed", &spec);
-    config_summary s = check_config("fixed (report count)", &spec, 5, 0, 0);
+    for (uint32_t band = 0; band <= 2; band++) {
+        config_summary s = check_config("fixed (report count)", &spec, 5, band_params(&spec, band), 0);
+        CHECK_MSG(s.min_count == 2789 && s.max_count == 2789, "%zu..%zu disks", s.min_count, s.max_count);
+        CHECK_NEAR(s.mean_density, 0.8762, 5e-5);
+    }
+    config_summary s = check_config("fixed (report count)", &spec, 5, default_params(&spec), 0);
     CHECK_MSG(s.min_count == 2789 && s.max_count == 2789, "%zu..%zu disks", s.min_count, s.max_count);
-    CHECK_NEAR(s.mean_density, 0.8762, 5e-5);
     gp_spec_free(&spec);
 }
 
@@ -131,7 +234,7 @@ static void test_level_bands_keep_every_property(void)
         for (uint32_t band = 1; band <= 4; band += 3) {
             gp_spec spec;
             load_example(cases[i], &spec);
-            check_config(cases[i], &spec, EXTRA_SEEDS, band, 1);
+            check_config(cases[i], &spec, EXTRA_SEEDS, band_params(&spec, band), 1);
             gp_spec_free(&spec);
         }
     }
@@ -176,8 +279,9 @@ static void test_other_laws_and_joints_hold_every_property(void)
         gp_spec spec;
         parse(configs[i].json, &spec);
         /* fidelity needs many disks per bin; the tiny domains are checked for geometry */
-        check_config(configs[i].label, &spec, EXTRA_SEEDS, 0, spec.expected_disks > 500);
-        check_config(configs[i].label, &spec, EXTRA_SEEDS / 4, 2, spec.expected_disks > 500);
+        check_config(configs[i].label, &spec, EXTRA_SEEDS, default_params(&spec), spec.expected_disks > 500);
+        check_config(configs[i].label, &spec, EXTRA_SEEDS / 4, band_params(&spec, 0), spec.expected_disks > 500);
+        check_config(configs[i].label, &spec, EXTRA_SEEDS / 4, band_params(&spec, 2), spec.expected_disks > 500);
         gp_spec_free(&spec);
     }
 }
@@ -205,8 +309,9 @@ static void test_turned_and_transposed_domains_fill_alike(void)
      * Both turnings are checked: the counts over many seeds agree within noise, whatever
      * the law and however narrow the strip (a 1 x 10 strip of r = 0.3 once got 2 disks
      * and the 10 x 1 one 17); and as the walk starts from a longest wall, the packing of
-     * H x W is the turned packing of W x H, disk for disk, for all but rare seeds where
-     * rounding tips one test the other way. */
+     * H x W is the turned packing of W x H, disk for disk, in exact arithmetic: with one
+     * radius on every seed, with several on the seeds where rounding never tips a test
+     * (a limit falling near the edge of a failure class, say) the other way. */
     static const struct {
         const char *label, *law;
         double W, H;
@@ -231,12 +336,13 @@ static void test_turned_and_transposed_domains_fill_alike(void)
         }
         double sum[2] = {0, 0}, sum2[2] = {0, 0};
         int turned = 0;
+        gp_pack_params base[2] = {default_params(&spec[0]), default_params(&spec[1])};
         for (int seed = 1; seed <= TURN_SEEDS; seed++) {
             gp_packing pk[2];
             gp_error err;
             for (int t = 0; t < 2; t++) {
-                gp_pack_params params = {&spec[t].domain, &spec[t].dist, &spec[t].joint, (uint64_t)seed, 0,
-                                         spec[t].level_band};
+                gp_pack_params params = base[t];
+                params.seed = (uint64_t)seed;
                 CHECK_MSG(gp_pack(&params, NULL, &pk[t], &err) == 0, "%s: %s", configs[i].label, err.message);
                 sum[t] += (double)pk[t].count;
                 sum2[t] += (double)pk[t].count * (double)pk[t].count;
@@ -254,8 +360,10 @@ static void test_turned_and_transposed_domains_fill_alike(void)
         double se = sqrt((var[0] + var[1]) / TURN_SEEDS);
         CHECK_MSG(fabs(mean[0] - mean[1]) <= 4.0 * se + 0.5, "%s: %.1f disks, turned %.1f (se %.2f)",
                   configs[i].label, mean[0], mean[1], se);
-        CHECK_MSG(turned >= TURN_SEEDS * 9 / 10, "%s: only %d of %d seeds give the turned packing",
-                  configs[i].label, turned, TURN_SEEDS);
+        /* one radius leaves nothing to rounding: the turned packing, disk for disk */
+        if (spec[0].dist.kind == GP_DIST_CONSTANT)
+            CHECK_MSG(turned == TURN_SEEDS, "%s: only %d of %d seeds give the turned packing",
+                      configs[i].label, turned, TURN_SEEDS);
         fprintf(stderr, "  %-28s %.1f disks, turned %.1f; the turned packing on %d of %d seeds\n",
                 configs[i].label, mean[0], mean[1], turned, TURN_SEEDS);
         gp_spec_free(&spec[0]);
@@ -272,7 +380,7 @@ static void test_narrow_strip_is_filled_along_its_length(void)
         parse(t ? "{\"domain\":{\"width\":1,\"height\":10},\"distribution\":{\"kind\":\"constant\",\"radius\":0.3}}"
                 : "{\"domain\":{\"width\":10,\"height\":1},\"distribution\":{\"kind\":\"constant\",\"radius\":0.3}}",
               &spec);
-        gp_pack_params params = {&spec.domain, &spec.dist, &spec.joint, 1, 0, 0};
+        gp_pack_params params = gp_spec_pack_params(&spec, 0);
         gp_packing pk;
         gp_error err;
         CHECK(gp_pack(&params, NULL, &pk, &err) == 0);
@@ -293,7 +401,7 @@ static void test_laws_beyond_the_limits_are_refused_not_packed(void)
     gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
     CHECK(gp_distribution_prepare(&dist) == 0);
     gp_domain dom = {100, 100};
-    gp_pack_params params = {&dom, &dist, NULL, 1, 0, 0};
+    gp_pack_params params = {.domain = &dom, .dist = &dist, .seed = 1, .rule = GP_FRONT_DEFAULT};
     gp_packing pk;
     gp_error err;
     CHECK(gp_pack(&params, NULL, &pk, &err) == GP_EINVAL);
@@ -315,7 +423,7 @@ static void test_cap_stops_the_packing_with_a_clear_error(void)
 {
     gp_spec spec;
     load_example("bagi", &spec);
-    gp_pack_params params = {&spec.domain, &spec.dist, &spec.joint, 1, 1000, 0};
+    gp_pack_params params = gp_spec_pack_params(&spec, 1000);
     gp_packing pk;
     gp_error err;
     CHECK(gp_pack(&params, NULL, &pk, &err) == GP_ETOOBIG);
@@ -336,7 +444,7 @@ static void test_progress_rises_to_one_and_cancel_stops_the_loop(void)
 {
     gp_spec spec;
     load_example("bagi", &spec);
-    gp_pack_params params = {&spec.domain, &spec.dist, &spec.joint, 1, 0, 0};
+    gp_pack_params params = gp_spec_pack_params(&spec, 0);
     double last = 0.0;
     gp_progress progress = {count_reports, &last, NULL};
     gp_packing pk;
@@ -385,7 +493,8 @@ static void test_cancel_stops_the_worst_law_at_the_next_check(void)
          * from the walk along the walls (their first ~40 disks, not their end at 1% of the
          * fill), and one where it comes from the front */
         gp_domain dom = walls_only ? (gp_domain){3000, 3} : (gp_domain){30, 30};
-        gp_pack_params params = {&dom, &dist, NULL, 1, 0, 0};
+        gp_pack_params params = {.domain = &dom, .dist = &dist, .seed = 1, .rule = GP_FRONT_WAIT,
+                                 .wait_levels = 4};
         cancel_on_report c = {0, 0, 0.0};
         atomic_init(&c.flag, 0);
         gp_progress progress = {raise_cancel, &c, &c.flag};
@@ -403,6 +512,8 @@ static void test_cancel_stops_the_worst_law_at_the_next_check(void)
 int main(void)
 {
     RUN(test_fixed_case_reproduces_the_report_count);
+    RUN(test_default_specs_reach_the_aimed_densities);
+    RUN(test_default_rule_is_the_pilots_choice);
     RUN(test_reference_cases_hold_every_property_over_200_seeds);
     RUN(test_level_bands_keep_every_property);
     RUN(test_other_laws_and_joints_hold_every_property);

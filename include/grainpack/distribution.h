@@ -58,6 +58,10 @@ void gp_distribution_support(const gp_distribution *dist, double *r_min, double 
 /* The expected value of (r + j(r))^2: the mean packing-disk area divided by pi. */
 double gp_distribution_mean_packing_r2(const gp_distribution *dist, const gp_joint *joint);
 
+/* The radius r below which a draw falls with probability q (q in [0, 1]; uniform within
+ * a bin, as the draws are). */
+double gp_distribution_quantile(const gp_distribution *dist, double q);
+
 /* The expected value of (r + j(r))^k, the k-th moment of the packing radius. */
 double gp_distribution_packing_moment(const gp_distribution *dist, const gp_joint *joint, int k);
 

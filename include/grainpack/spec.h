@@ -12,6 +12,7 @@
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
 #include "grainpack/laguerre.h"
+#include "grainpack/pack.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,6 +48,8 @@ typedef struct gp_spec {
     gp_joint joint;       /* GP_JOINT_NONE when the spec has no joint */
     uint64_t seed;
     uint32_t level_band;   /* see gp_pack_params; "front": {"level_band": n} */
+    int level_band_set;    /* the spec gave level_band: the report's rule with that band
+                              instead of the default rule (GP_FRONT_DEFAULT) */
     double expected_disks; /* estimate used against the cap */
     int balance_enabled;   /* the spec has "balance" (method "none" measures F only) */
     gp_balance_params balance; /* "balance": {"method", "max_iterations", "max_step"} */
@@ -79,6 +82,10 @@ double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *di
  * few large disks cannot pass the cap on its mean and then pack far more small ones. */
 double gp_spec_disk_bound(const gp_domain *domain, const gp_distribution *dist,
                           const gp_joint *joint);
+
+/* The packer's parameters for the spec (borrowing from it): its domain, law, joint and
+ * seed, and its front rule, the default unless the spec gave a level band. */
+gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks);
 
 /* Frees what the spec owns and zeroes it. */
 void gp_spec_free(gp_spec *spec);
