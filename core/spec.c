@@ -305,6 +305,10 @@ static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_
     return 0;
 }
 
+/* The spec's names of the front rules: "densest" (the default, gp_pack_default_rule's
+ * choice) and "level_band" (the report's rule with a band), in that order. */
+static const char *const front_rules[] = {"densest", "level_band", NULL};
+
 static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band,
                        int *band_set)
 {
@@ -312,15 +316,25 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
     const json_t *obj;
     int rc = get_object(v, inputs, base, "front", 0, &obj, ptr);
     *band = 0;
+    *band_set = 0;
     if (rc || !obj)
         return rc;
-    static const char *const members[] = {"level_band", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "level_band")))
+    static const char *const members[] = {"rule", "level_band", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "rule, level_band")))
         return rc;
     const json_t *value = json_object_get(obj, "level_band");
+    /* a level band alone asks for the report's rule, as it did before the rule existed */
+    int rule = value ? 1 : 0;
+    if (json_object_get(obj, "rule") &&
+        (rc = get_choice(v, obj, ptr, "rule", front_rules, "densest, level_band", &rule)))
+        return rc;
+    *band_set = rule == 1;
     if (!value)
         return 0;
     pointer_key(band_ptr, ptr, "level_band");
+    if (rule != 1)
+        return gp_error_set(v->err, GP_EINVAL, band_ptr,
+                            "only with \"rule\": \"level_band\" (the densest rule sets its own)");
     if (!json_is_integer(value))
         return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %s",
                             GP_SPEC_MAX_LEVEL_BAND, type_phrase(value));
@@ -329,7 +343,6 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
         return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %lld",
                             GP_SPEC_MAX_LEVEL_BAND, (long long)n);
     *band = (uint32_t)n;
-    *band_set = 1;
     return 0;
 }
 

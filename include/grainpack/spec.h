@@ -48,8 +48,9 @@ typedef struct gp_spec {
     gp_joint joint;       /* GP_JOINT_NONE when the spec has no joint */
     uint64_t seed;
     uint32_t level_band;   /* see gp_pack_params; "front": {"level_band": n} */
-    int level_band_set;    /* the spec gave level_band: the report's rule with that band
-                              instead of the default rule (GP_FRONT_DEFAULT) */
+    int level_band_set;    /* "front": {"rule": "level_band"} or a level_band given: the
+                              report's rule with that band, instead of the densest rule
+                              (GP_FRONT_DEFAULT, "rule": "densest", the default) */
     double expected_disks; /* estimate used against the cap */
     int balance_enabled;   /* the spec has "balance" (method "none" measures F only) */
     gp_balance_params balance; /* "balance": {"method", "max_iterations", "max_step"} */
@@ -86,6 +87,11 @@ double gp_spec_disk_bound(const gp_domain *domain, const gp_distribution *dist,
 /* The packer's parameters for the spec (borrowing from it): its domain, law, joint and
  * seed, and its front rule, the default unless the spec gave a level band. */
 gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks);
+
+/* The spec as JSON inputs, every default made explicit (seed, joint, front, the stages'
+ * options, picture): parsed again it gives the same spec. Returns a new jansson
+ * json_t reference the caller owns, or NULL when out of memory. */
+struct json_t *gp_spec_json(const gp_spec *spec);
 
 /* Frees what the spec owns and zeroes it. */
 void gp_spec_free(gp_spec *spec);
