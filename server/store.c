@@ -46,7 +46,8 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                   " grain_fraction = ?6, r_min = ?7, r_max = ?8, r_mean = ?9, chi2 = ?10,"
                   " dof = ?11, p_value = ?12, max_abs_z = ?13, initial_disks = ?14,"
                   " front_attempts = ?15, front_closures = ?16, front_frozen = ?17,"
-                  " front_capped = ?18, max_level = ?19"
+                  " front_capped = ?18, max_level = ?19, front_rule = ?20,"
+                  " front_wait_levels = ?21, front_alive_quantile = ?22"
                   " WHERE id = ?1 AND status = 'running'",
     [ST_RESULT] = "INSERT OR REPLACE INTO results (job_id, count, disks) VALUES (?1, ?2, ?3)",
     [ST_BIN] = "INSERT OR REPLACE INTO bin_stats (job_id, bin, min, max, target, achieved, count, z)"
@@ -62,7 +63,8 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                    " WHERE id = ?1 AND status IN ('accepted', 'running')",
     [ST_DELETE] = "DELETE FROM jobs WHERE id = ?1",
     [ST_LOAD] = "SELECT j.spec, r.count, r.disks, j.initial_disks, j.front_attempts,"
-                " j.front_closures, j.front_frozen, j.front_capped, j.max_level"
+                " j.front_closures, j.front_frozen, j.front_capped, j.max_level, j.front_rule,"
+                " j.front_wait_levels, j.front_alive_quantile"
                 " FROM jobs j JOIN results r ON r.job_id = j.id"
                 " WHERE j.id = ?1 AND j.status = 'successful' AND (?2 IS NULL OR j.owner = ?2)",
     [ST_TIMINGS] = "SELECT stage, seconds FROM stage_timings WHERE job_id = ?1 ORDER BY position",

@@ -29,7 +29,7 @@ enum {
 const char *gp_srv_strerror(int code);
 
 /* The schema version this build migrates to (PRAGMA user_version). */
-#define GP_STORE_SCHEMA_VERSION 2
+#define GP_STORE_SCHEMA_VERSION 3
 
 typedef enum gp_job_status {
     GP_JOB_ACCEPTED = 0,

@@ -91,6 +91,9 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     sqlite3_bind_int64(s, 17, (sqlite3_int64)p->frozen);
     sqlite3_bind_int64(s, 18, (sqlite3_int64)p->capped);
     sqlite3_bind_int64(s, 19, (sqlite3_int64)p->max_level);
+    sqlite3_bind_int(s, 20, (int)p->rule);
+    sqlite3_bind_int64(s, 21, (sqlite3_int64)p->wait_levels);
+    sqlite3_bind_double(s, 22, p->alive_quantile);
     rc = gp_db_run_one(db, s, "finish job"); /* GP_SRV_ESTATE: dismissed while it ran */
     if (rc == 0)
         rc = write_result_rows(db, id, result);
@@ -141,6 +144,9 @@ int gp_store_load_result(gp_db *db, const char *id, const char *owner, char **sp
         packing->frozen = (uint64_t)sqlite3_column_int64(s, 6);
         packing->capped = (uint64_t)sqlite3_column_int64(s, 7);
         packing->max_level = (uint32_t)sqlite3_column_int64(s, 8);
+        packing->rule = (gp_front_rule)sqlite3_column_int(s, 9);
+        packing->wait_levels = (uint32_t)sqlite3_column_int64(s, 10);
+        packing->alive_quantile = sqlite3_column_double(s, 11);
     }
     sqlite3_reset(s);
     if (result) {

@@ -54,5 +54,13 @@ static const char migration_2[] =
     "ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';"
     "CREATE INDEX jobs_by_owner ON jobs (owner, status, seq);";
 
-const char *const gp_store_migrations[] = {migration_1, migration_2};
+/* Version 3: the front's rule each job packed with (gp_front_rule, and the waiting rule's
+ * parameters), which the results' statistics report. Jobs finished before it packed with
+ * the report's rule: NULL reads as 0, GP_FRONT_LEVEL_BAND. */
+static const char migration_3[] =
+    "ALTER TABLE jobs ADD COLUMN front_rule INTEGER;"
+    "ALTER TABLE jobs ADD COLUMN front_wait_levels INTEGER;"
+    "ALTER TABLE jobs ADD COLUMN front_alive_quantile REAL;";
+
+const char *const gp_store_migrations[] = {migration_1, migration_2, migration_3};
 const size_t gp_store_migration_count = sizeof gp_store_migrations / sizeof gp_store_migrations[0];
