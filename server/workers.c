@@ -266,6 +266,7 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     int rc = gp_spec_parse(spec_text, spec_len, &unlimited, &spec, &err);
     if (rc == 0) {
         gp_progress progress = {report_progress, w, &w->cancel};
+        gp_metrics_pipeline_run(svc->metrics);
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
     }
     conclude(w, id, rc, &result, &err);
