@@ -16,7 +16,7 @@
 #define STEP_DECREMENT 0.05
 
 /* Centres between two progress reports and cancel checks: a few milliseconds of work. */
-#define CENTRES_PER_REPORT 16384
+#define CENTRES_PER_REPORT GP_QUALITY_CENTRES_PER_CHECK
 
 const char *gp_balance_method_name(gp_balance_method method)
 {
@@ -90,7 +90,7 @@ static int cell_inside_domain(const gp_domain *domain, const gp_disk *disks, con
 }
 
 int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, gp_error *err)
+               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err)
 {
     memset(stats, 0, sizeof *stats);
     ring_buffer buf = {malloc(64 * sizeof(int32_t)), 64};
@@ -102,6 +102,10 @@ int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, s
     }
     double sum = 0.0;
     for (size_t i = 0; i < n; i++) {
+        if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel)) {
+            rc = gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
+            goto done;
+        }
         int hull;
         size_t degree = ring_of(rt, (int32_t)i, &buf, &hull);
         if (degree == (size_t)-1) {
@@ -225,7 +229,7 @@ static int report(const gp_progress *progress, double fraction, gp_error *err)
 {
     if (!progress)
         return 0;
-    if (progress->cancel && atomic_load_explicit(progress->cancel, memory_order_relaxed))
+    if (gp_canceled(progress->cancel))
         return gp_error_set(err, GP_ECANCELED, NULL, "balancing canceled");
     if (progress->report)
         progress->report(progress->ctx, "balance", fraction);
@@ -304,6 +308,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
                       const gp_progress *progress, gp_balance_result *out, gp_error *err)
 {
     uint32_t cap = params->max_iterations ? params->max_iterations : GP_BALANCE_DEFAULT_MAX_ITERATIONS;
+    const gp_cancel_flag *cancel = gp_progress_cancel(progress);
     /* the grid is as fine as the packer's: about one cell per disk or fewer */
     int rc = gp_grid_init(&b->grid, b->domain, largest_radius(b->disks, b->n), b->n, 8 * b->n + 1024);
     if (rc)
@@ -327,8 +332,8 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
             break;
         }
         if ((rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, params->update,
-                                     &out->triangulation, err)) ||
-            (rc = gp_quality(b->domain, rt, b->disks, b->n, NULL, &now, err)) ||
+                                     &out->triangulation, progress, err)) ||
+            (rc = gp_quality(b->domain, rt, b->disks, b->n, NULL, &now, cancel, err)) ||
             (rc = report(progress, share * out->sweeps, err)))
             return rc;
         if (improves(&now, &best)) {
@@ -347,7 +352,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
     }
     restore_best(b);
     return gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, params->update,
-                              &out->triangulation, err);
+                              &out->triangulation, progress, err);
 }
 
 int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
@@ -376,13 +381,13 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
         rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", n);
         goto done;
     }
-    if ((rc = gp_quality(domain, rt, disks, n, NULL, &out->before, err)))
+    if ((rc = gp_quality(domain, rt, disks, n, NULL, &out->before, gp_progress_cancel(progress), err)))
         goto done;
     out->stop = GP_BALANCE_STOP_CONVERGED;
     if (params->method != GP_BALANCE_NONE && n > 0 &&
         (rc = run_sweeps(&b, rt, params, progress, out, err)))
         goto done;
-    rc = gp_quality(domain, rt, disks, n, out->F, &out->after, err);
+    rc = gp_quality(domain, rt, disks, n, out->F, &out->after, gp_progress_cancel(progress), err);
     if (rc == 0 && progress && progress->report)
         progress->report(progress->ctx, "balance", 1.0);
 done:

@@ -382,7 +382,7 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
     }
     for (size_t i = 0; i < n; i++) {
         if (progress && i % CELLS_PER_REPORT == CELLS_PER_REPORT - 1) {
-            if (progress->cancel && atomic_load_explicit(progress->cancel, memory_order_relaxed)) {
+            if (gp_canceled(progress->cancel)) {
                 rc = gp_error_set(err, GP_ECANCELED, NULL, "laguerre cells canceled");
                 goto done;
             }

@@ -16,8 +16,8 @@ static const double bucket_bounds[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025
                                        300};
 #define NBUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
 
-static const char *const outcome_names[] = {"successful", "failed",    "timed_out",
-                                            "dismissed",  "discarded", "requeued"};
+static const char *const outcome_names[] = {"successful", "failed",    "timed_out", "dismissed",
+                                            "discarded",  "requeued",  "abandoned"};
 #define NOUTCOMES (sizeof outcome_names / sizeof outcome_names[0])
 
 /* Durations are summed in microseconds so that the sum stays an atomic integer. */
@@ -137,8 +137,22 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
             "# HELP grainpack_workers Worker threads.\n# TYPE grainpack_workers gauge\n"
             "grainpack_workers %d\n"
             "# HELP grainpack_workers_busy Workers running a job.\n"
-            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n",
-            g->queue_depth, g->workers, g->workers_busy);
+            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n"
+            "# HELP grainpack_workers_abandoned Worker threads given up on (told to stop, "
+            "still running after seconds; another took each one's place).\n"
+            "# TYPE grainpack_workers_abandoned gauge\ngrainpack_workers_abandoned %d\n",
+            g->queue_depth, g->workers, g->workers_busy, g->workers_abandoned);
+    fprintf(f,
+            "# HELP grainpack_http_slow_heads_total Connections answered 408 and closed: their "
+            "request head was not complete within --connection-timeout.\n"
+            "# TYPE grainpack_http_slow_heads_total counter\ngrainpack_http_slow_heads_total %lu\n"
+            "# HELP grainpack_http_long_polls_hung_up_total Long-polls ended because their "
+            "client closed the connection.\n"
+            "# TYPE grainpack_http_long_polls_hung_up_total counter\n"
+            "grainpack_http_long_polls_hung_up_total %lu\n"
+            "# HELP grainpack_http_connections HTTP connections open, waiting long-polls "
+            "included.\n# TYPE grainpack_http_connections gauge\ngrainpack_http_connections %ld\n",
+            g->slow_heads, g->polls_hung_up, g->connections);
     fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
           "# TYPE grainpack_job_runs_total counter\n",
           f);

@@ -38,7 +38,10 @@ void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds);
 typedef struct gp_metrics_gauges {
     long jobs[GP_JOB_NSTATUS]; /* jobs in the store by status */
     long queue_depth;          /* accepted jobs waiting for a worker */
-    int workers, workers_busy;
+    int workers, workers_busy, workers_abandoned;
+    unsigned long slow_heads;     /* connections closed for a late request head */
+    long connections;             /* HTTP connections open */
+    unsigned long polls_hung_up;  /* long-polls ended by their client's hang-up */
 } gp_metrics_gauges;
 
 /* The whole exposition as a malloc'd text (caller frees), NULL when out of memory. */

@@ -57,8 +57,11 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                   " VALUES (?1, ?2, ?3, ?4)",
     [ST_FAIL] = "UPDATE jobs SET status = 'failed', error = ?2, message = ?3, finished = ?4,"
                 " updated = ?4 WHERE id = ?1 AND status = 'running'",
+    /* a stop that cancelled the job cleanly: its claim does not count (--max-job-attempts
+     * counts the runs the daemon died in) */
     [ST_REQUEUE] = "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
-                   " message = ?2, updated = ?3 WHERE id = ?1 AND status = 'running'",
+                   " message = ?2, updated = ?3, claims = max(claims - 1, 0)"
+                   " WHERE id = ?1 AND status = 'running'",
     [ST_STATUS] = "SELECT status FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
     [ST_DISMISS] = "UPDATE jobs SET status = 'dismissed', message = ?2, finished = ?3, updated = ?3"
                    " WHERE id = ?1 AND status IN ('accepted', 'running')",
@@ -311,24 +314,38 @@ static int migrate(gp_db *db, char *why, size_t why_size)
     }
 }
 
-static int requeue_running(gp_db *db, int *requeued, char *why, size_t why_size)
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up)
 {
-    char now[GP_TIMESTAMP_SIZE], sql[320];
+    /* a job still running in the store was running when the daemon died: its claims
+     * count the starts it did not survive (a clean stop gives its claim back) */
+    char now[GP_TIMESTAMP_SIZE], fail[512], requeue[320];
     gp_timestamp_now(now);
-    snprintf(sql, sizeof sql,
+    snprintf(fail, sizeof fail,
+             "UPDATE jobs SET status = 'failed', error = 'gave up', finished = '%s',"
+             " updated = '%s', message = 'failed: the daemon stopped ' || claims ||"
+             " ' times while this job ran (a crash, a kill, or a stop it did not answer"
+             " in time); it is not run again (--max-job-attempts %d)'"
+             " WHERE status = 'running' AND claims >= %d",
+             now, now, max_attempts, max_attempts);
+    snprintf(requeue, sizeof requeue,
              "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
              " message = '" GP_REQUEUE_MESSAGE "', updated = '%s'"
              " WHERE status = 'running'",
              now);
-    if (exec_sql(db->conn, "BEGIN IMMEDIATE", why, why_size) ||
-        exec_sql(db->conn, sql, why, why_size))
-        return GP_SRV_EDB;
-    int n = sqlite3_changes(db->conn);
-    if (exec_sql(db->conn, "COMMIT", why, why_size))
-        return GP_SRV_EDB;
-    if (requeued)
-        *requeued = n;
-    return 0;
+    int rc = gp_db_run(db, db->begin, "begin immediate");
+    if (rc)
+        return rc;
+    char *msg = NULL;
+    if (sqlite3_exec(db->conn, fail, NULL, NULL, &msg) != SQLITE_OK)
+        goto failed;
+    *given_up = sqlite3_changes(db->conn);
+    if (sqlite3_exec(db->conn, requeue, NULL, NULL, &msg) != SQLITE_OK)
+        goto failed;
+    *requeued = sqlite3_changes(db->conn);
+    return gp_db_end(db, 0);
+failed:
+    sqlite3_free(msg);
+    return gp_db_end(db, gp_db_fail(db, "recover running jobs"));
 }
 
 /* Adds db to the list of connections closed with the store. */
@@ -346,7 +363,7 @@ static int remember(gp_store *store, gp_db *db)
     return 0;
 }
 
-int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size)
+int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size)
 {
     *out = NULL;
     gp_store *store = calloc(1, sizeof *store);
@@ -360,8 +377,6 @@ int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, si
     if (db)
         db->store = store;
     int rc = db ? migrate(db, why, why_size) : GP_SRV_EDB;
-    if (rc == 0)
-        rc = requeue_running(db, requeued, why, why_size);
     if (rc == 0)
         rc = remember(store, db);
     if (rc) {

@@ -7,6 +7,7 @@
 #ifndef GRAINPACKD_STORE_H
 #define GRAINPACKD_STORE_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -63,11 +64,16 @@ typedef struct gp_job {
 typedef struct gp_store gp_store;
 typedef struct gp_db gp_db;
 
-/* Opens (creating if needed) the database at path, migrates it to the current schema and
- * queues again the jobs a crash left running (their count in *requeued, may be NULL).
+/* Opens (creating if needed) the database at path and migrates it to the current schema.
  * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why. The caller owns *out
  * (gp_store_close). */
-int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size);
+int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size);
+
+/* At start, the jobs a previous run left running (it died: a crash, a kill, a stop that
+ * gave up on a worker): those started max_attempts times or more (their claims; a clean
+ * stop gives its claim back) fail with a message that says why (*given_up counts them),
+ * the others are queued again (*requeued). Returns 0 or a write failure. */
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up);
 
 /* Closes every connection. All gp_db must have been released. */
 void gp_store_close(gp_store *store);
@@ -108,9 +114,13 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
                        size_t limit, gp_job *out, size_t *n, int *more);
 
 /* Claims the oldest accepted job atomically (UPDATE ... RETURNING): it becomes running.
- * Returns 0 with the id and a malloc'd copy of its spec text (caller frees), or
- * GP_SRV_ENOTFOUND when none waits, or GP_SRV_EDB. */
-int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len);
+ * *queued (the caller's count of accepted jobs; may be NULL) is decremented before the
+ * claim commits and given back if the commit fails, so that whoever sees the job running
+ * sees it out of the queue (the --max-queued admission reads that count). Returns 0
+ * with the id and a malloc'd copy of its spec text (caller frees), or GP_SRV_ENOTFOUND
+ * when none waits, or GP_SRV_EDB. */
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len);
 
 /* Records the progress of a running job (no-op when it is no longer running). */
 int gp_store_progress(gp_db *db, const char *id, int percent, const char *message);

@@ -168,7 +168,8 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
     return rc == SQLITE_ROW || rc == SQLITE_DONE ? 0 : gp_db_fail(db, "list jobs");
 }
 
-int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len)
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len)
 {
     *spec_text = NULL;
     *spec_len = 0;
@@ -199,7 +200,12 @@ int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t 
     if (rc != SQLITE_DONE && rc != SQLITE_ROW)
         result = gp_db_fail(db, "claim");
     sqlite3_reset(s);
+    int claimed = result == 0;
+    if (claimed && queued)
+        atomic_fetch_sub(queued, 1);
     result = gp_db_end(db, result);
+    if (claimed && result && queued)
+        atomic_fetch_add(queued, 1);
     if (result && result != GP_SRV_ENOTFOUND) {
         free(*spec_text);
         *spec_text = NULL;
