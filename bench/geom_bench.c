@@ -42,7 +42,7 @@ static void load(const char *dir, const char *name, gp_spec *spec)
 
 static void pack(const gp_spec *spec, gp_packing *pk)
 {
-    gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, spec->seed, 0, spec->level_band};
+    gp_pack_params params = gp_spec_pack_params(spec, 0);
     gp_error err;
     if (gp_pack(&params, NULL, pk, &err))
         die("pack", &err);

@@ -139,6 +139,19 @@ static int highest_class(const front_bucket *b, int below)
     return -1;
 }
 
+/* The lowest non-empty failure class of a bucket strictly above `above`, or -1. */
+static int lowest_class_above(const front_bucket *b, int above)
+{
+    for (int w = (above + 1) / 64; w < FRONT_FAIL_CLASSES / 64; w++) {
+        uint64_t bits = b->failed_mask[w];
+        if (w == (above + 1) / 64)
+            bits &= ~(((uint64_t)1 << ((above + 1) % 64)) - 1);
+        if (bits)
+            return w * 64 + __builtin_ctzll(bits);
+    }
+    return -1;
+}
+
 /* Puts node u's fresh segment at the head of its level's untried list. */
 static int bucket_push(front *f, int32_t u)
 {
@@ -176,7 +189,9 @@ int32_t front_top(const front *f, uint32_t level)
     const front_bucket *b = &f->buckets[level];
     if (b->untried != FRONT_NONE)
         return b->untried;
-    int c = highest_class(b, FRONT_FAIL_CLASSES - 1);
+    /* the tightest pocket: the one the front closes at if nothing takes the radius, which
+     * then costs the least empty space (docs/method.md §3.5) */
+    int c = lowest_class_above(b, -1);
     return c < 0 ? FRONT_NONE : b->failed[c];
 }
 
@@ -190,9 +205,12 @@ int32_t front_next_eligible(const front *f, uint32_t level, double R)
     /* Only classes above R's count as not having failed for R: members of R's own class
      * failed for radii within 1/FRONT_FAIL_CLASSES of the law's range of R, and are taken
      * as failing for R too. Walking that class to tell them apart made the search linear
-     * in the front when many segments had failed for similar radii. */
-    int c = highest_class(b, FRONT_FAIL_CLASSES - 1);
-    return c > fail_class(f, R) ? b->failed[c] : FRONT_NONE;
+     * in the front when many segments had failed for similar radii. Of the classes above,
+     * the lowest: the segment whose limit is the least above R, the tightest pocket that
+     * may take it (best fit, docs/method.md §3.5), which leaves the roomier pockets to the
+     * larger radii still to come. */
+    int c = lowest_class_above(b, fail_class(f, R));
+    return c < 0 ? FRONT_NONE : b->failed[c];
 }
 
 void front_mark_failed(front *f, int32_t u, double R)

@@ -35,7 +35,7 @@ typedef struct front_node {
     uint32_t level;         /* level(a) + level(b) (report eq. 5) */
     uint8_t state;          /* SEG_UNTRIED, SEG_FAILED or SEG_FROZEN */
     uint8_t fail_class;     /* SEG_FAILED: class of fail_R, the list it is in */
-    double fail_R;          /* smallest packing radius that failed here; +inf if untried */
+    double fail_R;          /* the segment takes no radius from fail_R up; +inf if untried */
     int32_t list_prev, list_next; /* neighbours in its list (untried, or failed of a class) */
     int32_t blocker;        /* SEG_FAILED: the disk last in the way, tested first next time */
     int32_t barrier_cell;   /* FRONT_NONE unless the segment is a registered barrier */
@@ -106,16 +106,17 @@ int front_add_loop(front *f, const int32_t *disks, size_t n);
 /* The lowest level holding a segment to work (meaningful while f->active > 0). */
 uint32_t front_low_level(front *f);
 
-/* The node whose segment to try first at `level` (the newest untried one, else one that
- * failed for a radius of the highest class), or FRONT_NONE when the level is empty. */
+/* The node whose segment to try first at `level` (the newest untried one, else one of the
+ * lowest failure class, the tightest pocket), or FRONT_NONE when the level is empty. */
 int32_t front_top(const front *f, uint32_t level);
 
-/* A node of `level` whose segment has not failed for a radius <= R (the newest untried
- * one first, then failed ones from the highest class down), or FRONT_NONE. A failure
- * radius in the same class as R counts as <= R (see front.c). */
+/* A node of `level` whose segment has not failed for a radius <= R: the newest untried
+ * one, else the failed one of the lowest class above R's (best fit), or FRONT_NONE. A
+ * failure radius in the same class as R counts as <= R (see front.c). */
 int32_t front_next_eligible(const front *f, uint32_t level, double R);
 
-/* Records that node u's segment failed for packing radius R (it keeps the smallest). */
+/* Records that node u's segment takes no packing radius from R up (it keeps the smallest
+ * such R): the radius that failed there, or the limit pack_fit_limit found below it. */
 void front_mark_failed(front *f, int32_t u, double R);
 
 /* Disk c was placed against node u's segment (a, b), touching a (and b too when

@@ -175,7 +175,12 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
     put(front, "attempts", json_integer((json_int_t)pk->attempts), &failed);
     put(front, "closures", json_integer((json_int_t)pk->closures), &failed);
     put(front, "frozen", json_integer((json_int_t)pk->frozen), &failed);
+    put(front, "rule", json_string(pk->rule == GP_FRONT_WAIT ? "wait" : "level_band"), &failed);
     put(front, "level_band", json_integer((json_int_t)spec->level_band), &failed);
+    if (pk->rule == GP_FRONT_WAIT) {
+        put(front, "wait_levels", json_integer((json_int_t)pk->wait_levels), &failed);
+        put(front, "alive_quantile", json_real(pk->alive_quantile), &failed);
+    }
     put(front, "max_level", json_integer((json_int_t)pk->max_level), &failed);
     put(root, "front", front, &failed);
     put(root, "seed", json_integer((json_int_t)spec->seed), &failed);

@@ -11,42 +11,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "front.h"
-#include "grid.h"
 #include "grow.h"
+#include "packer.h"
 
 /* Fraction of the domain a packing is expected to fill: used for the capacity guess and
  * to turn the filled area into a progress fraction. */
 #define FILL_GUESS 0.86
-/* Tries between two progress reports / cancel checks: well under a millisecond. */
-#define PROGRESS_EVERY 2048
 /* Closings a disk may start (as p1) before the segments it starts are frozen instead.
  * A disk of radius R_max ringed by disks of radius R_min has about pi (R_max + R_min) /
  * R_min neighbours, each of which may cost one closing: 64 covers a ratio of 20. With
  * simple loops the cap is never reached (it was not, over 160 runs of the reference
  * cases); it is there so that the loop stays finite whatever rounding does. */
 #define CLOSINGS_PER_DISK 64
-
-typedef struct packer {
-    const gp_pack_params *params;
-    const gp_progress *progress;
-    gp_rng rng;
-    double pending_r, pending_R; /* the drawn radius, kept until it is placed */
-
-    gp_disk *disks;
-    uint32_t *level;    /* per disk (report eq. 6) */
-    uint8_t *closings;  /* per disk: closings it started as p1 */
-    size_t count, capacity;
-    gp_grid grid;
-    front fr;
-
-    int32_t *conflicts; /* scratch for the closing step, room for two at least */
-    size_t conflict_capacity;
-
-    gp_packing *out;
-    gp_error *err;
-    uint64_t work_since_report;
-} packer;
 
 /* ---- radii ---- */
 
@@ -79,9 +55,7 @@ static int grow_disks(packer *pk)
     return 0;
 }
 
-/* Appends the pending radius as a disk at (x, y) with the given level and draws the next
- * radius. Returns its id, or a negative GP_E code. */
-static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
+int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level)
 {
     if (pk->params->max_disks && pk->count >= pk->params->max_disks)
         return gp_error_set(pk->err, GP_ETOOBIG, NULL,
@@ -101,11 +75,7 @@ static int32_t add_disk(packer *pk, double x, double y, uint32_t level)
     return id;
 }
 
-/* Whether a packing disk of radius R centred at (x, y) fits: inside the domain,
- * overlapping no disk but the two it was placed against, and crossing no barrier of the
- * front but the segment it was placed against. *blocker (when not NULL) gets the disk in
- * the way, or GP_GRID_NONE. */
-static int fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
+int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, int32_t skip_b,
                 int32_t skip_segment, int32_t *blocker)
 {
     int32_t q = GP_GRID_NONE;
@@ -127,115 +97,6 @@ static int overlaps_disk(const packer *pk, double x, double y, double R, int32_t
 static int front_oom(packer *pk)
 {
     return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the front");
-}
-
-/* ---- the initial front (docs/method.md §3.2) ---- */
-
-static int build_initial_front(packer *pk)
-{
-    const gp_domain *dom = pk->params->domain;
-    enum { N = GP_DOMAIN_CORNERS };
-    double vx[N], vy[N], ex[N], ey[N], nx[N], ny[N];
-    for (int i = 0; i < N; i++)
-        gp_domain_corner(dom, i, &vx[i], &vy[i]);
-    for (int i = 0; i < N; i++) {
-        double dx = vx[(i + 1) % N] - vx[i], dy = vy[(i + 1) % N] - vy[i];
-        double len = sqrt(dx * dx + dy * dy);
-        ex[i] = dx / len;
-        ey[i] = dy / len;
-        nx[i] = -ey[i]; /* inward: the domain is counter-clockwise */
-        ny[i] = ex[i];
-    }
-
-    /* One disk in each corner first, so that every edge knows where it must stop. The
-     * centre at distance R from both edges is v + R (n_prev + n) / (1 + n_prev . n). */
-    int32_t corner_disk[N];
-    for (int i = 0; i < N; i++) {
-        int p = (i + N - 1) % N;
-        double scale = pk->pending_R / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
-        double cx = vx[i] + scale * (nx[p] + nx[i]), cy = vy[i] + scale * (ny[p] + ny[i]);
-        corner_disk[i] = -1;
-        if (fits(pk, cx, cy, pk->pending_R, -1, -1, FRONT_NONE, NULL)) {
-            int32_t id = add_disk(pk, cx, cy, 0);
-            if (id < 0)
-                return id;
-            corner_disk[i] = id;
-        }
-    }
-
-    /* Then along each edge, counter-clockwise: each disk touches the wall and the disks
-     * before it on the edge (two disks touching a wall with radii R, R' have centres
-     * 2 sqrt(R R') apart along it; the new one goes as near the corner as that allows,
-     * which is tangent to the previous disk unless a tiny one sits between two large
-     * ones), until it would leave the domain past the next corner's disk. */
-    size_t loop_len = 0, loop_cap = 256;
-    int32_t *loop = malloc(loop_cap * sizeof *loop);
-    if (!loop)
-        return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
-    int rc = 0;
-    for (int i = 0; i < N && rc == 0; i++) {
-        if (corner_disk[i] < 0)
-            continue;
-        size_t edge_start = loop_len;
-        int32_t prev = corner_disk[i];
-        int p = (i + N - 1) % N;
-        /* a disk larger than the corner's must clear the previous wall too: at the least
-         * it sits where the corner disk would for its own radius */
-        double clear = (nx[p] * ex[i] + ny[p] * ey[i]) / (1.0 + nx[p] * nx[i] + ny[p] * ny[i]);
-        for (;;) {
-            int32_t *grown = grow(loop, &loop_cap, loop_len + 1, sizeof *loop);
-            if (!grown) {
-                rc = gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory for the initial front");
-                break;
-            }
-            loop = grown;
-            loop[loop_len++] = prev;
-            double R = pk->pending_R, t = clear * R;
-            double t_prev = (pk->disks[prev].x - vx[i]) * ex[i] + (pk->disks[prev].y - vy[i]) * ey[i];
-            /* only disks within 2 R_max of the last one along the edge can be in the way */
-            for (size_t k = loop_len; k-- > edge_start;) {
-                const gp_disk *dk = &pk->disks[loop[k]];
-                double tk = (dk->x - vx[i]) * ex[i] + (dk->y - vy[i]) * ey[i];
-                if (tk < t_prev - 2.0 * pk->grid.cell)
-                    break;
-                double reach = tk + 2.0 * sqrt(R * dk->R);
-                if (reach > t)
-                    t = reach;
-            }
-            /* any other disk in the way (the last ones of the previous edge, near the
-             * corner) pushes the disk on along the wall, past it; the edge ends when the
-             * disk would leave the domain, at the next corner */
-            double cx, cy;
-            int32_t q;
-            for (;;) {
-                cx = vx[i] + t * ex[i] + R * nx[i];
-                cy = vy[i] + t * ey[i] + R * ny[i];
-                if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
-                    break;
-                q = gp_grid_first_overlap(&pk->grid, pk->disks, cx, cy, R, -1, -1);
-                if (q == GP_GRID_NONE)
-                    break;
-                const gp_disk *dq = &pk->disks[q];
-                double tq = (dq->x - vx[i]) * ex[i] + (dq->y - vy[i]) * ey[i];
-                double hq = (dq->x - vx[i]) * nx[i] + (dq->y - vy[i]) * ny[i];
-                t = tq + sqrt((R + dq->R) * (R + dq->R) - (R - hq) * (R - hq));
-            }
-            if (!gp_domain_contains_disk(dom, cx, cy, R, R * GP_CONTACT_RTOL))
-                break;
-            int32_t id = add_disk(pk, cx, cy, 0);
-            if (id < 0) {
-                rc = id;
-                break;
-            }
-            prev = id;
-        }
-    }
-    pk->out->initial_front = pk->count;
-    /* fewer than three disks enclose nothing: the domain holds no more */
-    if (rc == 0 && loop_len >= 3 && front_add_loop(&pk->fr, loop, loop_len))
-        rc = front_oom(pk);
-    free(loop);
-    return rc;
 }
 
 /* ---- the loop (docs/method.md §3.5) ---- */
@@ -264,6 +125,7 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     front_node *nodes = pk->fr.nodes;
     const front_node *n = &nodes[u];
     int32_t a = n->disk, b = nodes[n->next].disk;
+    pk->blocked = -1;
     const gp_disk *da = &pk->disks[a], *db = &pk->disks[b];
     /* docs/method.md §3.1 with the segment's direction and length computed once per segment */
     double ra = da->R + R, rb = db->R + R, d = n->length;
@@ -287,14 +149,30 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
     for (int i = 0; i < 3; i++)
         if (likely[i] >= 0 && likely[i] != a && likely[i] != b &&
             overlaps_disk(pk, *x, *y, R, likely[i])) {
-            nodes[u].blocker = likely[i];
+            nodes[u].blocker = pk->blocked = likely[i];
             return 0;
         }
     int32_t q;
-    int ok = fits(pk, *x, *y, R, a, b, u, &q);
+    int ok = pack_fits(pk, *x, *y, R, a, b, u, &q);
+    pk->blocked = q;
     if (q != GP_GRID_NONE)
         nodes[u].blocker = q;
     return ok;
+}
+
+/* Records that node u's segment did not take radius R (find_position just said so): a
+ * disk in the way gives the limit from which no radius fits there, which spares the
+ * front trying the segment again for each radius above it; without one (a wall, a
+ * barrier), R itself is the limit. */
+static void mark_failed(packer *pk, int32_t u, double R)
+{
+    double limit = R;
+    if (pk->blocked >= 0) {
+        const front_node *n = &pk->fr.nodes[u];
+        limit = pack_fit_limit(&pk->disks[n->disk], &pk->disks[pk->fr.nodes[n->next].disk],
+                               n->length, n->ux, n->uy, &pk->disks[pk->blocked], pk->R_min, R);
+    }
+    front_mark_failed(&pk->fr, u, limit);
 }
 
 /* Whether node u's segment is wider than a disk of radius R can bridge. */
@@ -312,12 +190,14 @@ static int try_segment(packer *pk, int32_t u, int bridge_gap)
     double x, y;
     int touches_b;
     pk->out->attempts++;
-    pk->work_since_report++;
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
     if (!find_position(pk, u, pk->pending_R, bridge_gap, &x, &y, &touches_b))
         return 0;
     uint32_t la = pk->level[a], lb = pk->level[b];
     /* our definition of report eq. 6: one more than the lower of the two */
-    int32_t c = add_disk(pk, x, y, (la < lb ? la : lb) + 1);
+    int32_t c = pack_add_disk(pk, x, y, (la < lb ? la : lb) + 1);
     if (c < 0)
         return c;
     return front_place(&pk->fr, u, c, touches_b) ? front_oom(pk) : 1;
@@ -394,6 +274,9 @@ static int close_front(packer *pk, int32_t u)
     double x, y;
     int32_t w = FRONT_NONE;
     pk->out->closures++;
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
     if (pk->closings[p1] >= CLOSINGS_PER_DISK) {
         front_freeze(&pk->fr, u);
         pk->out->capped++;
@@ -414,14 +297,17 @@ static int close_front(packer *pk, int32_t u)
     return front_close(&pk->fr, u, w) ? front_oom(pk) : 0;
 }
 
-static int report_progress(packer *pk)
+int pack_check(packer *pk)
 {
-    pk->work_since_report = 0;
+    pk->work = 0;
     const gp_progress *pr = pk->progress;
     if (!pr)
         return 0;
     if (pr->cancel && atomic_load_explicit(pr->cancel, memory_order_relaxed))
         return gp_error_set(pk->err, GP_ECANCELED, NULL, "packing canceled after %zu disks", pk->count);
+    if (++pk->checks < PACK_CHECKS_PER_REPORT)
+        return 0;
+    pk->checks = 0;
     if (pr->report) {
         double expected = FILL_GUESS * gp_domain_area(pk->params->domain);
         double f = pk->out->fill_area / expected;
@@ -430,35 +316,73 @@ static int report_progress(packer *pk)
     return 0;
 }
 
+/* Tries the pending radius on the segments of levels from..to that have not failed for
+ * it, best fit first in each level (front_next_eligible), until one takes it. Returns 1
+ * if placed, 0 if not, or a GP_E code. */
+static int try_levels(packer *pk, uint32_t from, uint32_t to)
+{
+    for (uint32_t level = from; level <= to; level++) {
+        int32_t s;
+        while ((s = front_next_eligible(&pk->fr, level, pk->pending_R)) != FRONT_NONE) {
+            int placed = try_segment(pk, s, 0);
+            if (placed)
+                return placed;
+            mark_failed(pk, s, pk->pending_R);
+        }
+    }
+    return 0;
+}
+
+/* Whether the pocket at node u's segment, which just failed the pending radius, would
+ * take a disk of radius R_alive: then it is worth waiting for one. 1, 0 or a GP_E code. */
+static int pocket_alive(packer *pk, int32_t u)
+{
+    if (!(pk->fr.nodes[u].fail_R > pk->R_alive))
+        return 0; /* its limit is already below */
+    int rc = pack_work(pk, pk->query_units);
+    if (rc)
+        return rc;
+    double x, y;
+    int touches_b;
+    if (find_position(pk, u, pk->R_alive, 0, &x, &y, &touches_b))
+        return 1;
+    mark_failed(pk, u, pk->R_alive);
+    return 0;
+}
+
+/* The loop of docs/method.md §3.5. The first segment of the front's level is tried first,
+ * whatever it failed for before; then every segment of the level band that has not
+ * failed for a radius <= R, lowest level first; under the waiting rule, when the first
+ * segment's pocket would take a radius of the law's alive quantile, the radius climbs up
+ * to pk->wait levels more; only then is the front closed at the first segment.
+ *
+ * Work per placed disk (docs/method.md §3.7): every pass of this loop tests the first
+ * segment, then places a disk, or closes or freezes the first segment. A closing is
+ * counted against its p1 (at most CLOSINGS_PER_DISK each) and a freeze takes a segment
+ * off for good, and each placement or closing makes at most two segments: so passes,
+ * segments and closings are all O(disks). Every other test either places the disk or
+ * lowers a segment's failure class (FRONT_FAIL_CLASSES of them), or tests the alive
+ * radius once per pass; each test is one grid query of at most (6 rho + 2)^2 / pi disks,
+ * rho = R_max / R_min <= GP_PACK_MAX_RADIUS_RATIO. */
 static int run_front(packer *pk)
 {
-    uint32_t band = pk->params->level_band;
     while (pk->fr.active > 0) {
-        if (pk->work_since_report >= PROGRESS_EVERY) {
-            int rc = report_progress(pk);
-            if (rc)
-                return rc;
-        }
-        /* the first segment of the front's level is tried first, whatever it failed for
-         * before; then every segment of the level band that has not failed for a radius
-         * <= R, lowest level first; and only then is the front closed at the first */
         uint32_t low = front_low_level(&pk->fr);
         int32_t first = front_top(&pk->fr, low);
         int placed = try_segment(pk, first, 0);
         if (placed < 0)
             return placed;
-        if (!placed)
-            front_mark_failed(&pk->fr, first, pk->pending_R);
-        for (uint32_t level = low; level <= low + band && !placed; level++) {
-            int32_t s;
-            while (!placed && (s = front_next_eligible(&pk->fr, level, pk->pending_R)) != FRONT_NONE) {
-                placed = try_segment(pk, s, 0);
-                if (placed < 0)
-                    return placed;
-                if (!placed)
-                    front_mark_failed(&pk->fr, s, pk->pending_R);
-            }
+        if (!placed) {
+            mark_failed(pk, first, pk->pending_R);
+            placed = try_levels(pk, low, low + pk->band);
         }
+        if (!placed && pk->wait) {
+            placed = pocket_alive(pk, first);
+            if (placed > 0)
+                placed = try_levels(pk, low + pk->band + 1, low + pk->band + pk->wait);
+        }
+        if (placed < 0)
+            return placed;
         if (!placed && too_wide(pk, first, pk->pending_R)) {
             /* a gap wider than the radius is filled from one end before it is given up */
             placed = try_segment(pk, first, 1);
@@ -471,6 +395,68 @@ static int run_front(packer *pk)
                 return rc;
         }
     }
+    return 0;
+}
+
+gp_pack_law_limit gp_pack_check_law(const gp_domain *domain, const gp_distribution *dist,
+                                    const gp_joint *joint, gp_error *err)
+{
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(dist, &r_min, &r_max);
+    gp_joint_packing_range(joint, r_min, r_max, &R_min, &R_max);
+    if (!(R_max <= GP_PACK_MAX_RADIUS_RATIO * R_min)) {
+        gp_error_set(err, GP_EINVAL, NULL,
+                     "packing radii from %g to %g span a ratio of %.3g, more than the packer's "
+                     "limit of %g: the work to test a position grows with the square of that "
+                     "ratio, so such a law could take unbounded time (docs/method.md §3.7)",
+                     R_min, R_max, R_max / R_min, GP_PACK_MAX_RADIUS_RATIO);
+        return GP_PACK_LAW_RATIO;
+    }
+    double side = domain->width > domain->height ? domain->width : domain->height;
+    if (!(side <= GP_PACK_MAX_SIDE_RADII * R_min)) {
+        gp_error_set(err, GP_EINVAL, NULL,
+                     "the smallest packing radius %g is too small for a domain side of %g "
+                     "(%.3g radii, the limit is %g): disks placed in double precision that far "
+                     "from the origin would overlap by more than the contact tolerance "
+                     "(docs/method.md §3.7)",
+                     R_min, side, side / R_min, GP_PACK_MAX_SIDE_RADII);
+        return GP_PACK_LAW_PRECISION;
+    }
+    return GP_PACK_LAW_OK;
+}
+
+/* Sets the packer's rule from params (running the pilots for the default) and records it
+ * in the output. Returns 0 or a GP_E code with err set. */
+static int set_rule(packer *pk, double R_min)
+{
+    const gp_pack_params *params = pk->params;
+    gp_packing *out = pk->out;
+    out->rule = params->rule == GP_FRONT_LEVEL_BAND ? GP_FRONT_LEVEL_BAND : GP_FRONT_WAIT;
+    pk->R_min = R_min;
+    if (params->rule == GP_FRONT_LEVEL_BAND) {
+        pk->band = params->level_band;
+        return 0;
+    }
+    out->wait_levels = params->wait_levels;
+    out->alive_quantile = params->alive_quantile;
+    if (params->rule == GP_FRONT_DEFAULT) {
+        int rc = gp_pack_default_rule(params->dist, params->joint, pk->progress, &out->wait_levels,
+                                      &out->alive_quantile, pk->err);
+        if (rc)
+            return rc;
+    } else if (params->rule != GP_FRONT_WAIT || out->wait_levels < 1 ||
+               out->wait_levels > GP_PACK_MAX_WAIT_LEVELS || !(out->alive_quantile >= 0.0) ||
+               !(out->alive_quantile < 1.0)) {
+        return gp_error_set(pk->err, GP_EINVAL, NULL,
+                            "the waiting rule needs 1 to %d levels and a quantile in [0, 1), got "
+                            "%u and %g",
+                            GP_PACK_MAX_WAIT_LEVELS, out->wait_levels, out->alive_quantile);
+    }
+    pk->wait = out->wait_levels;
+    /* the smallest radius for quantile 0, whatever the joint does to the law's ends */
+    double r = gp_distribution_quantile(params->dist, out->alive_quantile);
+    double R = gp_joint_packing_radius(params->joint, r);
+    pk->R_alive = out->alive_quantile > 0.0 && R > R_min ? R : R_min;
     return 0;
 }
 
@@ -493,6 +479,19 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
         !(params->domain->height >= 2 * R_max))
         return gp_error_set(err, GP_EINVAL, NULL,
                             "the largest packing disk (R = %g) does not fit in the domain", R_max);
+    if (gp_pack_check_law(params->domain, params->dist, params->joint, err))
+        return GP_EINVAL;
+    int rc = set_rule(&pk, R_min);
+    if (rc) {
+        memset(out, 0, sizeof *out);
+        return rc;
+    }
+
+    /* The disks a grid query may test: those with centres in the 3 x 3 cells of side
+     * 2 R_max around the candidate, disjoint and of radius R_min at least, so within the
+     * block grown by R_min: (6 R_max + 2 R_min)^2 / (pi R_min^2) of them at most. */
+    double ratio = R_max / R_min;
+    pk.query_units = 1 + (uint64_t)((6.0 * ratio + 2.0) * (6.0 * ratio + 2.0) / M_PI / PACK_TESTS_PER_UNIT);
 
     /* room for the expected number of disks, so that large runs never copy the arrays */
     double expected = FILL_GUESS * gp_domain_area(params->domain) /
@@ -502,7 +501,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
         capacity = params->max_disks + 1;
 
     /* the grid has about one cell per expected disk or fewer (cells are 2 R_max wide) */
-    int rc = gp_grid_init(&pk.grid, params->domain, R_max, capacity, (size_t)(4.0 * expected) + 1024);
+    rc = gp_grid_init(&pk.grid, params->domain, R_max, capacity, (size_t)(4.0 * expected) + 1024);
     if (rc == GP_ETOOBIG)
         gp_error_set(err, rc, NULL, "the bucket grid would be too large for this domain");
     else if (rc)
@@ -521,7 +520,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
     }
     if (rc == 0) {
         draw_radius(&pk);
-        rc = build_initial_front(&pk);
+        rc = pack_walls(&pk);
     }
     if (rc == 0)
         rc = run_front(&pk);

@@ -32,14 +32,7 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
                     gp_result *result, gp_error *err)
 {
     memset(result, 0, sizeof *result);
-    gp_pack_params params = {
-        .domain = &spec->domain,
-        .dist = &spec->dist,
-        .joint = &spec->joint,
-        .seed = spec->seed,
-        .max_disks = max_disks,
-        .level_band = spec->level_band,
-    };
+    gp_pack_params params = gp_spec_pack_params(spec, max_disks);
     gp_rt *rt = NULL;
     gp_packing *pk = &result->packing;
     double t0 = now_seconds();

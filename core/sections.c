@@ -88,6 +88,9 @@ static void encode_pack(enc *e, const gp_result *r)
     put_u64(e, p->frozen);
     put_u64(e, p->capped);
     put_u32(e, p->max_level);
+    put_u32(e, (uint32_t)p->rule);
+    put_u32(e, p->wait_levels);
+    put_f64(e, p->alive_quantile);
     put_f64(e, p->fill_area);
     put_f64(e, s->domain_area);
     put_f64(e, s->packing_density);
@@ -320,6 +323,13 @@ static int decode_pack(dec *d, gp_result *r)
     p->frozen = get_u64(d);
     p->capped = get_u64(d);
     p->max_level = get_u32(d);
+    /* a packing ran under one of two rules (the default is the waiting rule it chose) */
+    uint32_t rule = get_u32(d);
+    if (rule != GP_FRONT_LEVEL_BAND && rule != GP_FRONT_WAIT)
+        d->failed = 1;
+    p->rule = (gp_front_rule)rule;
+    p->wait_levels = get_u32(d);
+    p->alive_quantile = get_f64(d);
     p->fill_area = get_f64(d);
     s->domain_area = get_f64(d);
     s->packing_density = get_f64(d);

@@ -3,7 +3,9 @@
  * that a reader skips tags it does not know and a later stage (a mesh) adds its own.
  *
  * Tags and layouts (version 1; little-endian; f64 = IEEE double, u32/u64/i32 integers):
- *   "pack"            the packing's diagnostics and statistics (gp_pack_stats, with its bins)
+ *   "pack"            the packing's diagnostics (with the front's rule and, for the waiting
+ *                     rule, wait_levels and alive_quantile) and statistics (gp_pack_stats,
+ *                     with its bins)
  *   "disks"           per grain: x, y, r, R (f64 each, 32 bytes)
  *   "balance"         the balancing run: method, step, F before and after (gp_quality_stats),
  *                     sweeps, stop, moves, how the triangulation followed

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "grow.h"
+#include "grainpack/pack.h"
 
 /* Packing density assumed by the disk-count estimate: a little above what the front
  * reaches (0.80-0.88), so that the estimate errs on the high side. */
@@ -305,21 +306,36 @@ static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_
     return 0;
 }
 
-static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band)
+/* The spec's names of the front rules: "densest" (the default, gp_pack_default_rule's
+ * choice) and "level_band" (the report's rule with a band), in that order. */
+static const char *const front_rules[] = {"densest", "level_band", NULL};
+
+static int parse_front(validator *v, const json_t *inputs, const char *base, uint32_t *band,
+                       int *band_set)
 {
     char ptr[GP_ERROR_POINTER_MAX], band_ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
     int rc = get_object(v, inputs, base, "front", 0, &obj, ptr);
     *band = 0;
+    *band_set = 0;
     if (rc || !obj)
         return rc;
-    static const char *const members[] = {"level_band", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "level_band")))
+    static const char *const members[] = {"rule", "level_band", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "rule, level_band")))
         return rc;
     const json_t *value = json_object_get(obj, "level_band");
+    /* a level band alone asks for the report's rule, as it did before the rule existed */
+    int rule = value ? 1 : 0;
+    if (json_object_get(obj, "rule") &&
+        (rc = get_choice(v, obj, ptr, "rule", front_rules, "densest, level_band", &rule)))
+        return rc;
+    *band_set = rule == 1;
     if (!value)
         return 0;
     pointer_key(band_ptr, ptr, "level_band");
+    if (rule != 1)
+        return gp_error_set(v->err, GP_EINVAL, band_ptr,
+                            "only with \"rule\": \"level_band\" (the densest rule sets its own)");
     if (!json_is_integer(value))
         return gp_error_set(v->err, GP_EINVAL, band_ptr, "must be an integer from 0 to %d, got %s",
                             GP_SPEC_MAX_LEVEL_BAND, type_phrase(value));
@@ -451,6 +467,28 @@ static int parse_seed(validator *v, const json_t *inputs, const char *base, uint
     return 0;
 }
 
+/* The JSON pointer of the field giving the law's smallest radius, into out
+ * (GP_ERROR_POINTER_MAX bytes). */
+static void smallest_radius_pointer(const char *base, const gp_distribution *dist, char *out)
+{
+    char law[GP_ERROR_POINTER_MAX], bins[GP_ERROR_POINTER_MAX], bin[GP_ERROR_POINTER_MAX];
+    pointer_key(law, base, "distribution");
+    switch (dist->kind) {
+    case GP_DIST_CONSTANT: pointer_key(out, law, "radius"); return;
+    case GP_DIST_UNIFORM: pointer_key(out, law, "min"); return;
+    case GP_DIST_HISTOGRAM: {
+        size_t i = 0; /* bins are sorted: the first drawn one holds the smallest radius */
+        while (i + 1 < dist->nbins && !(dist->bins[i].p > 0.0))
+            i++;
+        pointer_key(bins, law, "bins");
+        pointer_index(bin, bins, i);
+        pointer_key(out, bin, "min");
+        return;
+    }
+    }
+    snprintf(out, GP_ERROR_POINTER_MAX, "%s", law);
+}
+
 double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
                               const gp_joint *joint)
 {
@@ -458,8 +496,54 @@ double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *di
     return EXPECTED_FILL * gp_domain_area(domain) / (M_PI * mean_R2);
 }
 
+/* The chance, at most, that a packing holds more disks than gp_spec_disk_bound says. */
+#define DISK_BOUND_RISK 1e-9
+
+double gp_spec_disk_bound(const gp_domain *domain, const gp_distribution *dist,
+                          const gp_joint *joint)
+{
+    /* Disjoint disks inside the domain cover at most its area, so a packing of n disks has
+     * drawn n radii whose R^2 sum to at most A / pi. For X = R^2 with mean mu, variance
+     * var, and mu - X <= spread, Bernstein's inequality bounds the chance that n draws sum
+     * to no more than n mu - t by exp(-t^2 / (2 n var + 2 spread t / 3)); the bound is the
+     * least n (found by bisection, the exponent growing with n) that makes it at most
+     * DISK_BOUND_RISK with t = n mu - A / pi. It exceeds the plain estimate most where a
+     * few large disks carry the mean of R^2: leave them out and the small ones number far
+     * more. (Hoeffding's inequality, with the range R_max^2 - R_min^2 in place of the
+     * variance, gives a looser bound on such laws.) */
+    double mu = gp_distribution_packing_moment(dist, joint, 2);
+    double var = gp_distribution_packing_moment(dist, joint, 4) - mu * mu;
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(dist, &r_min, &r_max);
+    gp_joint_packing_range(joint, r_min, r_max, &R_min, &R_max);
+    double spread = mu - R_min * R_min, area = gp_domain_area(domain) / M_PI;
+    double log_risk = -log(DISK_BOUND_RISK);
+    if (!(mu > 0.0))
+        return INFINITY;
+    if (var < 0.0)
+        var = 0.0;
+    double lo = area / mu, hi = 2.0 * lo + 16.0;
+    for (int grow = 0; grow < 64; grow++) {
+        double t = hi * mu - area;
+        if (t * t >= log_risk * (2.0 * hi * var + 2.0 * spread * t / 3.0))
+            break;
+        hi *= 2.0;
+    }
+    for (int i = 0; i < 64 && hi - lo > 0.5; i++) {
+        double n = 0.5 * (lo + hi), t = n * mu - area;
+        if (t * t >= log_risk * (2.0 * n * var + 2.0 * spread * t / 3.0))
+            hi = n;
+        else
+            lo = n;
+    }
+    /* and n disks of radius R_min at least cover n pi R_min^2 <= A: a hard bound */
+    double hard = area / (R_min * R_min);
+    return ceil(hi < hard ? hi : hard);
+}
+
 /* Checks that spans the fields: the law fits the domain, j(r) stays finite on the
- * support, the expected disk count is under the cap. */
+ * support, the packer can pack the law in bounded time and to the contact tolerance, and
+ * the disk count is under the cap however the draws fall (but for DISK_BOUND_RISK). */
 static int check_whole(validator *v, const char *base, gp_spec *spec)
 {
     char dist_ptr[GP_ERROR_POINTER_MAX], joint_ptr[GP_ERROR_POINTER_MAX],
@@ -481,12 +565,22 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
                             "the largest packing disk (diameter %g, grain radius up to %g plus "
                             "joint) must fit in the domain, whose smaller side is %g",
                             2.0 * R_max, r_max, side);
+    gp_pack_law_limit limit = gp_pack_check_law(&spec->domain, &spec->dist, &spec->joint, v->err);
+    if (limit != GP_PACK_LAW_OK) {
+        /* the joint is at fault when the grain radii alone are within the ratio */
+        if (limit == GP_PACK_LAW_RATIO && r_max <= GP_PACK_MAX_RADIUS_RATIO * r_min)
+            snprintf(v->err->pointer, sizeof v->err->pointer, "%s", joint_ptr);
+        else
+            smallest_radius_pointer(base, &spec->dist, v->err->pointer);
+        return GP_EINVAL;
+    }
     spec->expected_disks = gp_spec_expected_disks(&spec->domain, &spec->dist, &spec->joint);
-    if (!(spec->expected_disks <= (double)v->max_disks))
+    double bound = gp_spec_disk_bound(&spec->domain, &spec->dist, &spec->joint);
+    if (!(bound <= (double)v->max_disks))
         return gp_error_set(v->err, GP_ETOOBIG, domain_ptr,
-                            "about %.3g disks expected, more than the limit of %zu; use a smaller "
-                            "domain or larger grains",
-                            spec->expected_disks, v->max_disks);
+                            "about %.3g disks expected and up to %.3g possible, more than the limit "
+                            "of %zu; use a smaller domain or larger grains",
+                            spec->expected_disks, bound, v->max_disks);
     return 0;
 }
 
@@ -520,7 +614,7 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = parse_seed(v, inputs, base, &spec->seed)) ||
-        (rc = parse_front(v, inputs, base, &spec->level_band)) ||
+        (rc = parse_front(v, inputs, base, &spec->level_band, &spec->level_band_set)) ||
         (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
         (rc = parse_picture(v, inputs, base, spec)) || (rc = check_whole(v, base, spec)))
         return rc;
@@ -591,6 +685,20 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
         rc = gp_spec_parse(text, len, limits, spec, err);
     free(text);
     return rc;
+}
+
+gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks)
+{
+    gp_pack_params params = {
+        .domain = &spec->domain,
+        .dist = &spec->dist,
+        .joint = &spec->joint,
+        .seed = spec->seed,
+        .max_disks = max_disks,
+        .level_band = spec->level_band,
+        .rule = spec->level_band_set ? GP_FRONT_LEVEL_BAND : GP_FRONT_DEFAULT,
+    };
+    return params;
 }
 
 void gp_spec_free(gp_spec *spec)

@@ -62,7 +62,10 @@ json_t *gp_spec_json(const gp_spec *spec)
     put(in, "distribution", distribution_json(&spec->dist, &failed), &failed);
     put(in, "joint", joint_json(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
-    put(in, "front", json_pack("{s:i}", "level_band", (int)spec->level_band), &failed);
+    /* the rule named, so that the densest default parses back as the default */
+    put(in, "front", spec->level_band_set
+                         ? json_pack("{s:s, s:i}", "rule", "level_band", "level_band", (int)spec->level_band)
+                         : json_pack("{s:s}", "rule", "densest"), &failed);
     if (spec->balance_enabled)
         put(in, "balance", json_pack("{s:s, s:i, s:f}", "method",
                                      gp_balance_method_name(spec->balance.method), "max_iterations",

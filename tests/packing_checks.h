@@ -122,10 +122,12 @@ static inline size_t hex_patch(gp_disk *d, int rows, int cols, double x0, double
     return n;
 }
 
-/* Packs `spec` with `seed` (its own level band), aborting the test program if it cannot. */
+/* Packs `spec` with `seed` (and its own front rule), aborting the test program if it
+ * cannot. */
 static inline void pack_seed(const gp_spec *spec, uint64_t seed, gp_packing *pk)
 {
-    gp_pack_params params = {&spec->domain, &spec->dist, &spec->joint, seed, 0, spec->level_band};
+    gp_pack_params params = gp_spec_pack_params(spec, 0);
+    params.seed = seed;
     gp_error err;
     if (gp_pack(&params, NULL, pk, &err)) {
         fprintf(stderr, "cannot pack seed %llu: %s\n", (unsigned long long)seed, err.message);

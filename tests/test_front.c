@@ -149,7 +149,7 @@ static void test_a_triangle_closed_vanishes(void)
     teardown(&fx);
 }
 
-static void test_newest_untried_first_then_largest_failed_radius(void)
+static void test_newest_untried_first_then_the_best_fit(void)
 {
     fixture fx;
     setup(&fx, 6);
@@ -160,16 +160,20 @@ static void test_newest_untried_first_then_largest_failed_radius(void)
     CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 4);
     /* an untried segment is eligible for any radius, a failed one only below its radius */
     CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.9)].disk == 4);
-    /* once all have failed (4 for 0.5, 3 for 0.4, ... 0 for 0.1), the one that failed for
-     * the largest radius is first */
+    /* once all have failed (4 for 0.5, 3 for 0.4, ... 0 for 0.1), the first segment is
+     * the tightest pocket, the one that failed for the smallest radius; the one a radius
+     * is tried on next is the best fit, the one whose limit is the least above the radius */
     for (int i = 4; i >= 0; i--)
         front_mark_failed(&fx.f, front_top(&fx.f, 0), 0.1 * (i + 1));
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 5);
+    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 0);
     CHECK(front_next_eligible(&fx.f, 0, 0.6) == FRONT_NONE);
     CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.55)].disk == 5);
-    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.45)].disk == 5);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.45)].disk == 4);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.15)].disk == 1);
     front_mark_failed(&fx.f, node_of(&fx.f, 5), 0.45); /* a smaller failure lowers it */
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 4);  /* failed for 0.5 */
+    CHECK(fx.f.nodes[node_of(&fx.f, 5)].fail_R == 0.45);
+    CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.35)].disk == 3);
+    /* 0.449 is in 0.45's class, which counts as failed for it: 4 (0.5) is the best fit */
     CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.449)].disk == 4);
     CHECK(fx.f.nodes[front_next_eligible(&fx.f, 0, 0.46)].disk == 4);
     CHECK(front_next_eligible(&fx.f, 0, 0.5) == FRONT_NONE);
@@ -177,7 +181,9 @@ static void test_newest_untried_first_then_largest_failed_radius(void)
     CHECK(fx.f.nodes[node_of(&fx.f, 4)].fail_R == 0.5);
     front_freeze(&fx.f, node_of(&fx.f, 4));
     CHECK(fx.f.active == 5 && fx.f.frozen == 1);
-    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 5);
+    CHECK(front_next_eligible(&fx.f, 0, 0.46) == FRONT_NONE);
+    front_freeze(&fx.f, node_of(&fx.f, 0));
+    CHECK(fx.f.nodes[front_top(&fx.f, 0)].disk == 1);
     CHECK(front_next_eligible(&fx.f, 0, 0.05) != FRONT_NONE);
     teardown(&fx);
 }
@@ -209,7 +215,7 @@ int main(void)
     RUN(test_close_on_the_disk_before_cuts_the_other_ear);
     RUN(test_close_across_splits_the_loop_in_two);
     RUN(test_a_triangle_closed_vanishes);
-    RUN(test_newest_untried_first_then_largest_failed_radius);
+    RUN(test_newest_untried_first_then_the_best_fit);
     RUN(test_gap_segments_are_barriers_and_touching_ones_are_not);
     return check_status();
 }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "json_values.h"
 #include "sections.h"
 #include "packing_checks.h"
 #include "render_checks.h"
@@ -17,6 +18,10 @@ typedef struct stored {
     unsigned char *copy[GP_SECTIONS_MAX];
     size_t reads; /* calls of read_stored */
 } stored;
+
+/* Where the pack section's layout puts the front's rule: after six u64 counts (disks,
+ * initial front, attempts, closures, frozen, capped) and max_level (u32). */
+#define RULE_OFFSET (6 * 8 + 4)
 
 static void store(stored *st, const gp_result *r)
 {
@@ -201,9 +206,64 @@ static void test_corrupt_sections_are_refused(void)
     gp_spec_free(&spec);
 }
 
+/* The pack section keeps the front's rule the packing ran under, with the waiting rule's
+ * parameters: the statistics' front from the sections is the one in memory, for the report's
+ * rule, for the densest default (the waiting rule it chose: iron's quantile is 0), and for
+ * waiting parameters set by hand to values with every bit of the double significant. */
+static void test_pack_section_keeps_the_front_rule(void)
+{
+    for (int k = 0; k < 3; k++) {
+        int level_band = k == 0;
+        gp_spec spec;
+        gp_result r;
+        load_example("iron", &spec);
+        spec.level_band_set = level_band;
+        gp_error err;
+        CHECK_MSG(gp_pipeline_run(&spec, 0, NULL, &r, &err) == 0, "%s", err.message);
+        gp_packing *p = &r.packing;
+        CHECK(p->rule == (level_band ? GP_FRONT_LEVEL_BAND : GP_FRONT_WAIT));
+        CHECK(level_band ||
+              (p->wait_levels >= 1 && p->alive_quantile >= 0.0 && p->alive_quantile < 1.0));
+        if (k == 2) {
+            p->wait_levels = GP_PACK_MAX_WAIT_LEVELS;
+            p->alive_quantile = 1.0 / 3.0;
+        }
+        stored st;
+        store(&st, &r);
+        gp_result summary;
+        CHECK(decode(&st, &summary) == 0);
+        CHECK(summary.packing.rule == p->rule && summary.packing.wait_levels == p->wait_levels &&
+              memcmp(&summary.packing.alive_quantile, &p->alive_quantile, sizeof(double)) == 0);
+        json_t *want = gp_statistics_json(&spec, &r), *got = gp_statistics_json(&spec, &summary);
+        char *a = json_dumps(want, JSON_SORT_KEYS), *b = json_dumps(got, JSON_SORT_KEYS);
+        CHECK_MSG(a && b && strcmp(a, b) == 0, "rule %d: statistics from the sections differ",
+                  (int)p->rule);
+        free(a);
+        free(b);
+        json_decref(want);
+        json_decref(got);
+        gp_result_free(&summary);
+        /* a rule no packing runs under (the default is resolved before packing) is refused */
+        for (size_t i = 0; i < st.n; i++) {
+            if (strcmp(st.sections[i].tag, GP_SECTION_PACK) != 0)
+                continue;
+            uint32_t rule = GP_FRONT_DEFAULT;
+            memcpy(st.copy[i] + RULE_OFFSET, &rule, sizeof rule);
+            memset(&summary, 0, sizeof summary);
+            CHECK(gp_section_decode_summary(GP_SECTION_PACK, st.sections[i].version, st.copy[i],
+                                            st.sections[i].size, &summary) == GP_EPARSE);
+            gp_result_free(&summary);
+        }
+        unstore(&st);
+        gp_result_free(&r);
+        gp_spec_free(&spec);
+    }
+}
+
 int main(void)
 {
     RUN(test_every_format_reads_the_same_from_sections);
     RUN(test_corrupt_sections_are_refused);
+    RUN(test_pack_section_keeps_the_front_rule);
     return check_status();
 }

@@ -102,11 +102,15 @@ static const char staged_spec[] =
     " \"balance\": {\"method\": \"relocation\", \"max_iterations\": 3},"
     " \"laguerre\": {\"shrink\": \"offset\"}, \"picture\": {\"color\": \"quality\"}}}";
 
-static void run_spec(const char *text, gp_spec *spec, gp_result *r)
+/* Runs the pipeline on a spec text; report_rule packs with the report's level rule whatever
+ * the text says (as version 2 packed every job: it knew no other rule). */
+static void run_spec(const char *text, int report_rule, gp_spec *spec, gp_result *r)
 {
     gp_error err;
     CHECK(gp_spec_parse(text, strlen(text), NULL, spec, &err) == 0);
+    spec->level_band_set |= report_rule;
     CHECK_MSG(gp_pipeline_run(spec, 0, NULL, r, &err) == 0, "%s", err.message);
+    CHECK(r->packing.rule == (spec->level_band_set ? GP_FRONT_LEVEL_BAND : GP_FRONT_WAIT));
 }
 
 /* What a download reads: a stored result's sections through a reader. */
@@ -204,10 +208,10 @@ static void test_a_version_2_database_is_upgraded_with_its_results(void)
 {
     const char *plain_spec = "{\"inputs\": {\"domain\": {\"width\": 30, \"height\": 20},"
                              " \"distribution\": {\"kind\": \"uniform\", \"min\": 0.3, \"max\": 0.8}}}";
-    gp_spec staged, plain;
-    gp_result ran_staged, ran_plain;
-    run_spec(staged_spec, &staged, &ran_staged);
-    run_spec(plain_spec, &plain, &ran_plain);
+    gp_spec staged, plain, fresh_spec;
+    gp_result ran_staged, ran_plain, ran_fresh;
+    run_spec(staged_spec, 1, &staged, &ran_staged);
+    run_spec(plain_spec, 1, &plain, &ran_plain);
 
     /* version 2 exactly as it was: its two migrations' DDL, its results table */
     remove_database();
@@ -250,18 +254,21 @@ static void test_a_version_2_database_is_upgraded_with_its_results(void)
     check_formats(db, "v2-plain", &plain, &ran_plain); /* nothing was lost: the same bytes */
 
     /* the queued job of version 2 can still be dismissed; a new job gets a version 3
-     * result: what every stage produced, F before balancing too */
+     * result: what every stage produced, F before balancing too, and the front's rule (the
+     * densest default's waiting rule, with the parameters it chose) */
     gp_job_status before;
     int deleted;
     CHECK(gp_store_dismiss(db, "v2-queued", "alice", &before, &deleted, &job) == 0 && !deleted);
+    run_spec(staged_spec, 0, &fresh_spec, &ran_fresh);
     gp_job fresh;
-    CHECK(gp_store_insert_job(db, "", 0, staged_spec, strlen(staged_spec), &staged, &fresh, NULL) == 0);
+    CHECK(gp_store_insert_job(db, "", 0, staged_spec, strlen(staged_spec), &fresh_spec, &fresh,
+                              NULL) == 0);
     char id[GP_JOB_ID_SIZE], *text;
     size_t len;
     CHECK(gp_store_claim(db, NULL, id, &text, &len) == 0 && strcmp(id, fresh.id) == 0);
     free(text);
-    CHECK(gp_store_finish(db, fresh.id, &ran_staged) == 0);
-    check_formats(db, fresh.id, &staged, &ran_staged);
+    CHECK(gp_store_finish(db, fresh.id, &ran_fresh) == 0);
+    check_formats(db, fresh.id, &fresh_spec, &ran_fresh);
 
     gp_store_release(store, db);
     gp_store_close(store);
@@ -277,8 +284,10 @@ static void test_a_version_2_database_is_upgraded_with_its_results(void)
     sqlite3_close(conn);
     gp_result_free(&ran_staged);
     gp_result_free(&ran_plain);
+    gp_result_free(&ran_fresh);
     gp_spec_free(&staged);
     gp_spec_free(&plain);
+    gp_spec_free(&fresh_spec);
 }
 
 static void test_a_reader_stops_when_the_job_is_deleted_under_it(void)
@@ -287,7 +296,7 @@ static void test_a_reader_stops_when_the_job_is_deleted_under_it(void)
     gp_db *db = open_fresh(&store);
     gp_spec spec;
     gp_result r;
-    run_spec(staged_spec, &spec, &r);
+    run_spec(staged_spec, 0, &spec, &r);
     gp_job job;
     CHECK(gp_store_insert_job(db, "", 0, staged_spec, strlen(staged_spec), &spec, &job, NULL) == 0);
     char id[GP_JOB_ID_SIZE], *text;

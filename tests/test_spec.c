@@ -49,7 +49,27 @@ static void test_defaults_seed_one_no_joint_band_zero(void)
                 "\"radius\":0.5}}",
                 &s, &err) == 0);
     CHECK(s.seed == GP_SPEC_DEFAULT_SEED && s.joint.law == GP_JOINT_NONE && s.level_band == 0);
+    CHECK(!s.level_band_set && gp_spec_pack_params(&s, 0).rule == GP_FRONT_DEFAULT);
     gp_spec_free(&s);
+    /* the front's rule: the densest unless named, or a band given */
+    static const struct {
+        const char *front;
+        int band_set;
+        uint32_t band;
+    } fronts[] = {{"{}", 0, 0}, {"{\"rule\":\"densest\"}", 0, 0}, {"{\"rule\":\"level_band\"}", 1, 0},
+                  {"{\"rule\":\"level_band\",\"level_band\":4}", 1, 4}, {"{\"level_band\":0}", 1, 0}};
+    for (size_t i = 0; i < sizeof fronts / sizeof fronts[0]; i++) {
+        char text[256];
+        snprintf(text, sizeof text, "{\"domain\":{\"width\":10,\"height\":10},\"distribution\":"
+                 "{\"kind\":\"constant\",\"radius\":0.5},\"front\":%s}", fronts[i].front);
+        CHECK_MSG(parse(text, &s, &err) == 0, "%s: %s", fronts[i].front, err.message);
+        gp_pack_params p = gp_spec_pack_params(&s, 0);
+        CHECK_MSG(s.level_band_set == fronts[i].band_set && s.level_band == fronts[i].band &&
+                      p.rule == (fronts[i].band_set ? GP_FRONT_LEVEL_BAND : GP_FRONT_DEFAULT) &&
+                      p.level_band == fronts[i].band,
+                  "%s", fronts[i].front);
+        gp_spec_free(&s);
+    }
     CHECK(parse("{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"uniform\","
                 "\"min\":0.1,\"max\":0.5},\"joint\":{\"law\":\"power\",\"k\":1,\"exponent\":-0.5},"
                 "\"front\":{\"level_band\":2},\"seed\":12345678901}",
@@ -116,11 +136,30 @@ static const error_case errors[] = {
     {"{" DOM "," CONST ",\"seed\":1.5}", GP_EINVAL, "/seed", "got a number"},
     {"{" DOM "," CONST ",\"front\":{\"level_band\":99}}", GP_EINVAL, "/front/level_band", "from 0 to 16, got 99"},
     {"{" DOM "," CONST ",\"front\":{\"band\":1}}", GP_EINVAL, "/front/band", "unknown field"},
+    {"{" DOM "," CONST ",\"front\":{\"rule\":\"dense\"}}", GP_EINVAL, "/front/rule", "must be one of densest, level_band"},
+    {"{" DOM "," CONST ",\"front\":{\"rule\":\"densest\",\"level_band\":1}}", GP_EINVAL, "/front/level_band",
+     "only with \"rule\": \"level_band\""},
     {"{\"domain\":{\"width\":3,\"height\":300},\"distribution\":{\"kind\":\"constant\",\"radius\":2}}", GP_EINVAL, "/distribution",
      "must fit in the domain"},
     {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"constant\",\"radius\":2},\"joint\":{\"law\":\"power\",\"k\":1,\"exponent\":1e300}}",
      GP_EINVAL, "/joint", "non-finite"},
     {"{\"domain\":{\"width\":1e5,\"height\":1e5}," CONST "}", GP_ETOOBIG, "/domain", "more than the limit of 20000000"},
+    /* laws the packer cannot pack in bounded time or to the contact tolerance
+     * (docs/method.md §3.7): the pointer names the smallest radius, or the joint when the
+     * grain radii alone are within the ratio */
+    {"{\"domain\":{\"width\":100,\"height\":100},\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1e-06,"
+     "\"max\":2e-06,\"p\":0.5},{\"min\":1,\"max\":1.1,\"p\":0.5}]}}",
+     GP_EINVAL, "/distribution/bins/0/min", "span a ratio of 1.1e+06, more than the packer's limit of 100"},
+    {"{\"domain\":{\"width\":100,\"height\":100},\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1e-03,"
+     "\"max\":2e-03,\"p\":0},{\"min\":0.005,\"max\":0.01,\"p\":0.5},{\"min\":1,\"max\":1.1,\"p\":0.5}]}}",
+     GP_EINVAL, "/distribution/bins/1/min", "span a ratio of 220"},
+    {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"uniform\",\"min\":0.004,\"max\":0.5}}",
+     GP_EINVAL, "/distribution/min", "the work to test a position grows with the square"},
+    {"{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":\"uniform\",\"min\":0.01,\"max\":0.5},"
+     "\"joint\":{\"law\":\"power\",\"k\":10,\"exponent\":2}}",
+     GP_EINVAL, "/joint", "more than the packer's limit of 100"},
+    {"{\"domain\":{\"width\":20000,\"height\":1},\"distribution\":{\"kind\":\"constant\",\"radius\":0.01}}",
+     GP_EINVAL, "/distribution/radius", "too small for a domain side of 20000 (2e+06 radii, the limit is 1e+06)"},
     {"{\"domain\":{\"width\":5,\"height\":5}," CONST ",\"domain\":{\"width\":6,\"height\":6}}", GP_EPARSE, "", "duplicate"},
     {"{" DOM "," CONST ",\"balance\":[]}", GP_EINVAL, "/balance", "must be an object, got an array"},
     {"{" DOM "," CONST ",\"balance\":{}}", GP_EINVAL, "/balance/method", "missing; expected one of none, laplacian, relocation"},
@@ -209,6 +248,26 @@ static void test_caps_are_configurable(void)
     gp_spec_limits small = {.max_disks = 1000};
     CHECK(gp_spec_parse(json, strlen(json), &small, &s, &err) == GP_ETOOBIG);
     CHECK(strstr(err.message, "1000") != NULL);
+    /* the cap holds against the bound, not the mean: about 12000 disks expected, but the
+     * mean disk area is carried by rare large disks, and with few of them drawn the small
+     * ones number up to ~76000 (the domain's area over theirs) */
+    const char *rare_large = "{\"domain\":{\"width\":10,\"height\":10},\"distribution\":{\"kind\":"
+                             "\"histogram\",\"bins\":[{\"min\":0.02,\"max\":0.021,\"p\":0.9995},{\"min\":1.9,"
+                             "\"max\":2,\"p\":0.0005}]}}";
+    gp_spec_limits fifty_thousand = {.max_disks = 50000};
+    CHECK(gp_spec_parse(rare_large, strlen(rare_large), &fifty_thousand, &s, &err) == GP_ETOOBIG);
+    CHECK_STR(err.pointer, "/domain");
+    CHECK_MSG(strstr(err.message, "about 1.23e+04 disks expected and up to 7.96e+04 possible") != NULL,
+              "%s", err.message);
+    gp_spec_limits hundred_thousand = {.max_disks = 100000};
+    CHECK(gp_spec_parse(rare_large, strlen(rare_large), &hundred_thousand, &s, &err) == 0);
+    /* the bound sits above the plain estimate, at the domain's area over the mean disk area
+     * or more, and at most at its area over the smallest disk's (no packing of disjoint
+     * disks covers more than the domain) */
+    double bound = gp_spec_disk_bound(&s.domain, &s.dist, &s.joint);
+    CHECK(bound >= 100.0 / (M_PI * gp_distribution_mean_packing_r2(&s.dist, &s.joint)));
+    CHECK(bound > s.expected_disks && bound <= ceil(100.0 / (M_PI * 0.02 * 0.02)));
+    gp_spec_free(&s);
     gp_spec_limits few_bins = {.max_bins = 1};
     const char *two = "{" DOM ",\"distribution\":{\"kind\":\"histogram\",\"bins\":[{\"min\":1,\"max\":2,"
                       "\"p\":0.5},{\"min\":2,\"max\":3,\"p\":0.5}]}}";
@@ -242,7 +301,8 @@ static int same_spec(const gp_spec *a, const gp_spec *b)
                a->dist.nbins == b->dist.nbins && a->joint.law == b->joint.law &&
                a->joint.value == b->joint.value && a->joint.k == b->joint.k &&
                a->joint.exponent == b->joint.exponent && a->seed == b->seed &&
-               a->level_band == b->level_band && a->expected_disks == b->expected_disks &&
+               a->level_band == b->level_band && a->level_band_set == b->level_band_set &&
+               a->expected_disks == b->expected_disks &&
                a->balance_enabled == b->balance_enabled &&
                a->balance.method == b->balance.method &&
                a->balance.max_iterations == b->balance.max_iterations &&
@@ -266,6 +326,8 @@ static void test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit(vo
         "{\"domain\":{\"width\":10.1,\"height\":0.7e1},\"distribution\":{\"kind\":\"uniform\","
         "\"min\":0.1,\"max\":0.3},\"joint\":{\"law\":\"power\",\"k\":0.1,\"exponent\":-0.5},"
         "\"front\":{\"level_band\":3},\"seed\":9223372036854775807}",
+        "{" DOM "," CONST ",\"front\":{\"rule\":\"level_band\"}}",
+        "{" DOM "," CONST ",\"front\":{\"rule\":\"densest\"}}",
         "{" DOM "," CONST ",\"joint\":{\"law\":\"constant\",\"value\":0.1},\"balance\":"
         "{\"method\":\"laplacian\",\"max_iterations\":7,\"max_step\":0.3},\"laguerre\":"
         "{\"shrink\":\"offset\",\"flush_boundary\":true},\"picture\":{\"color\":\"radius\","
@@ -288,7 +350,10 @@ static void test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit(vo
         /* the defaults are written out: a reader sees what the job will do */
         CHECK(json_integer_value(json_object_get(first, "seed")) == (json_int_t)a.seed);
         CHECK(json_object_get(json_object_get(first, "joint"), "law") != NULL);
-        CHECK(json_object_get(json_object_get(first, "front"), "level_band") != NULL);
+        /* the rule is named: the densest unless the spec gave a band */
+        const char *rule = json_string_value(json_object_get(json_object_get(first, "front"), "rule"));
+        CHECK(rule && strcmp(rule, a.level_band_set ? "level_band" : "densest") == 0);
+        CHECK((json_object_get(json_object_get(first, "front"), "level_band") != NULL) == a.level_band_set);
         CHECK(json_object_get(json_object_get(first, "picture"), "color") != NULL);
         CHECK((json_object_get(first, "balance") != NULL) == a.balance_enabled);
         if (a.balance_enabled)

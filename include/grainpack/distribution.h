@@ -59,6 +59,13 @@ GP_API void gp_distribution_support(const gp_distribution *dist, double *r_min, 
 /* The expected value of (r + j(r))^2: the mean packing-disk area divided by pi. */
 GP_API double gp_distribution_mean_packing_r2(const gp_distribution *dist, const gp_joint *joint);
 
+/* The radius r below which a draw falls with probability q (q in [0, 1]; uniform within
+ * a bin, as the draws are). */
+GP_API double gp_distribution_quantile(const gp_distribution *dist, double q);
+
+/* The expected value of (r + j(r))^k, the k-th moment of the packing radius. */
+GP_API double gp_distribution_packing_moment(const gp_distribution *dist, const gp_joint *joint, int k);
+
 /* The bins achieved radii are reported against: the histogram's own, ten equal bins for
  * the uniform law, one degenerate bin for a constant radius. Writes at most `cap` bins to
  * `out` and returns how many there are. */

@@ -13,6 +13,7 @@
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
 #include "grainpack/laguerre.h"
+#include "grainpack/pack.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -48,6 +49,9 @@ typedef struct gp_spec {
     gp_joint joint;       /* GP_JOINT_NONE when the spec has no joint */
     uint64_t seed;
     uint32_t level_band;   /* see gp_pack_params; "front": {"level_band": n} */
+    int level_band_set;    /* "front": {"rule": "level_band"} or a level_band given: the
+                              report's rule with that band, instead of the densest rule
+                              (GP_FRONT_DEFAULT, "rule": "densest", the default) */
     double expected_disks; /* estimate used against the cap */
     int balance_enabled;   /* the spec has "balance" (method "none" measures F only) */
     gp_balance_params balance; /* "balance": {"method", "max_iterations", "max_step"} */
@@ -75,6 +79,16 @@ GP_API int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_
  * packing-disk area. Used for the disk cap. */
 GP_API double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
                                      const gp_joint *joint);
+
+/* A number of disks no packing of the law in the domain exceeds but with a chance below
+ * 1e-9: the cap is checked against it, so that a law whose mean disk area is carried by a
+ * few large disks cannot pass the cap on its mean and then pack far more small ones. */
+GP_API double gp_spec_disk_bound(const gp_domain *domain, const gp_distribution *dist,
+                                 const gp_joint *joint);
+
+/* The packer's parameters for the spec (borrowing from it): its domain, law, joint and
+ * seed, and its front rule, the default unless the spec gave a level band. */
+GP_API gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks);
 
 /* Frees what the spec owns and zeroes it. */
 GP_API void gp_spec_free(gp_spec *spec);

@@ -11,6 +11,7 @@ import { HistogramEditor } from './histogram.js';
 
 // Friendlier labels than the field names, where a name alone says too little.
 const LABELS = {
+  rule: 'Front rule',
   level_band: 'Level band',
   max_iterations: 'Largest number of sweeps',
   max_step: 'First step (fraction of the way)',

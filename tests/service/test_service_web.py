@@ -152,7 +152,7 @@ def check_validation(c, api, client, daemon):
     r = client.post_json("/processes/pack2d/validation", {"inputs": {"domain": {"width": 30, "height": 30},
                                                                       "distribution": {"kind": "constant", "radius": 0.9}}})
     bare = r.json()["inputs"]
-    c.check(bare["seed"] == 1 and bare["joint"] == {"law": "none"} and bare["front"] == {"level_band": 0}
+    c.check(bare["seed"] == 1 and bare["joint"] == {"law": "none"} and bare["front"] == {"rule": "densest"}
             and bare["picture"] == {"color": "radius", "disks": False} and "balance" not in bare,
             f"defaults of a bare spec: {bare}")
     again = client.post_json("/processes/pack2d/validation", {"inputs": inputs}).json()
