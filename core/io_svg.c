@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "grainpack/io.h"
+#include "io_svg_mesh.h"
 
 /* Colour classes of the scale; more would not be told apart on screen. */
 #define COLOR_CLASSES 16
@@ -190,6 +191,12 @@ static void draw_legend(FILE *out, const gp_spec *spec, const gp_result *result,
     if (result->has_cells)
         fprintf(out, "<text x=\"0\" y=\"%.*f\">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
                 dec, line_y += 1.4 * font, gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);
+    if (result->has_mesh) {
+        const gp_mesh_stats *ms = &result->mesh.stats;
+        fprintf(out, "<text x=\"0\" y=\"%.*f\">mesh%s: %zu triangles, %zu quadrilaterals, %zu nodes, angles %.1f to %.1f degrees</text>\n",
+                dec, line_y += 1.4 * font, gp_svg_mesh_drawable(&result->mesh) ? "" : " (too fine to draw)",
+                ms->triangles, ms->quads, ms->nodes, ms->min_angle, ms->max_angle);
+    }
     fputs("</g>\n", out);
 }
 
@@ -208,7 +215,7 @@ int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result)
     decimals = decimals < 0 ? 0 : (decimals > 9 ? 9 : decimals);
 
     double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
-    double legend_h = bar_h + (3.5 + 1.4 * (result->has_balance + result->has_cells)) * font;
+    double legend_h = bar_h + (3.5 + 1.4 * (result->has_balance + result->has_cells + result->has_mesh)) * font;
     double vw = W + 2 * margin, vh = H + 2 * margin + legend_h;
     double px = PICTURE_PX / L;
     fprintf(out,
@@ -226,6 +233,15 @@ int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result)
         draw_cells(out, spec, result, &c, H, decimals);
     else
         draw_disks(out, result, &c, H, decimals);
+    if (result->has_mesh) {
+        gp_out mesh_out;
+        if (gp_out_init_file(&mesh_out, out))
+            return GP_ENOMEM;
+        int rc = gp_svg_mesh(&mesh_out, result, H, decimals);
+        gp_out_free(&mesh_out);
+        if (rc)
+            return rc;
+    }
     fprintf(out,
             "<rect x=\"0\" y=\"0\" width=\"%.17g\" height=\"%.17g\" fill=\"none\" "
             "stroke=\"" OUTLINE "\" stroke-width=\"%.*f\"/>\n",

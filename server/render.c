@@ -121,7 +121,7 @@ int gp_render_load(gp_db *db, const char *id, const char *owner, gp_spec *spec, 
     if (rc)
         return rc;
     /* accepted once, so parsed without today's caps */
-    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
     gp_error err;
     rc = gp_spec_parse(text, len, &unlimited, spec, &err);
     free(text);

@@ -50,7 +50,7 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
-    gp_spec_limits limits = {svc->cfg->max_disks, svc->cfg->max_bins};
+    gp_spec_limits limits = {svc->cfg->max_disks, svc->cfg->max_bins, svc->cfg->max_elements};
     gp_spec spec;
     gp_error err;
     gp_error_clear(&err);

@@ -18,10 +18,14 @@ typedef enum gp_format {
     GP_FORMAT_JSON = 0,
     GP_FORMAT_CSV,
     GP_FORMAT_SVG,
-    GP_FORMAT_VTK
+    GP_FORMAT_VTK,
+    GP_FORMAT_MSH, /* the mesh: Gmsh MSH 4.1 (io_mesh.h) */
+    GP_FORMAT_INP, /* the mesh: Abaqus input */
+    GP_FORMAT_VTU  /* the mesh, or the grains without one: VTK XML unstructured grid */
 } gp_format;
 
-/* Maps "json", "csv", "svg" or "vtk" to a format; returns 0 or GP_EINVAL. */
+/* Maps "json", "csv", "svg", "vtk", "msh", "inp" or "vtu" to a format; returns 0 or
+ * GP_EINVAL. */
 int gp_format_parse(const char *name, gp_format *out);
 const char *gp_format_name(gp_format format);
 /* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,
@@ -43,7 +47,12 @@ int gp_write_csv(FILE *out, const gp_result *result);
 int gp_write_json(FILE *out, const gp_spec *spec, const gp_result *result);
 int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result);
 int gp_write_vtk(FILE *out, const gp_spec *spec, const gp_result *result);
+/* Writes the result in `format`; GP_EINVAL for msh and inp when the job has no mesh
+ * (gp_format_needs_mesh). */
 int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result);
+
+/* Whether the format exists only for jobs with a mesh (msh, inp). */
+int gp_format_needs_mesh(gp_format format);
 
 #ifdef __cplusplus
 }
