@@ -8,6 +8,24 @@
 /* An angle this much below the bound (degrees) is below it: rounding of atan2. */
 #define ANGLE_SLACK 1e-9
 
+/* A sum with Neumaier's compensation: a mesh's 10^6 element areas added to a running
+ * total lose up to 10^6 half-ulps of it (2e-7 of a domain of area 10^4) without it. */
+typedef struct exact_sum {
+    double sum, carry;
+} exact_sum;
+
+static void add(exact_sum *s, double x)
+{
+    double t = s->sum + x;
+    s->carry += fabs(s->sum) >= fabs(x) ? (s->sum - t) + x : (x - t) + s->sum;
+    s->sum = t;
+}
+
+static double total(const exact_sum *s)
+{
+    return s->sum + s->carry;
+}
+
 /* The corner angles (degrees) of element `index`, into angle[]; returns how many. */
 static int corner_angles(const gp_mesh *mesh, int quad, size_t index, double *angle)
 {
@@ -38,6 +56,7 @@ void gp_mesh_compute_stats(gp_mesh *mesh, double min_angle, const gp_domain *dom
     s->min_input_angle = min_input_angle;
     s->domain_area = gp_domain_area(domain);
     double quality_sum = 0.0;
+    exact_sum all = {0, 0}, grains = {0, 0}, phase = {0, 0}, polygons = {0, 0};
     for (int quad = 0; quad < 2; quad++) {
         size_t count = quad ? mesh->nquad : mesh->ntri;
         const int32_t *region = quad ? mesh->quad_region : mesh->tri_region;
@@ -58,18 +77,19 @@ void gp_mesh_compute_stats(gp_mesh *mesh, double min_angle, const gp_domain *dom
             bin = bin < 0 ? 0 : bin >= GP_MESH_QUALITY_BINS ? GP_MESH_QUALITY_BINS - 1 : bin;
             s->quality_histogram[bin]++;
             double a = gp_mesh_element_area(mesh, quad, e);
-            s->element_area += a;
-            if (gp_mesh_region_phase(mesh, region[e]) == GP_PHASE_GRAIN)
-                s->grain_area += a;
-            else
-                s->phase_area += a;
+            add(&all, a);
+            add(gp_mesh_region_phase(mesh, region[e]) == GP_PHASE_GRAIN ? &grains : &phase, a);
         }
     }
     size_t elements = mesh->ntri + mesh->nquad;
     s->quality_mean = elements ? quality_sum / (double)elements : 0.0;
     if (!elements)
         s->min_angle = s->quality_min = 0.0;
+    s->element_area = total(&all);
+    s->grain_area = total(&grains);
+    s->phase_area = total(&phase);
     for (size_t g = 0; g < mesh->ngrains; g++)
-        s->grain_polygon_area += mesh->region_area[g];
+        add(&polygons, mesh->region_area[g]);
+    s->grain_polygon_area = total(&polygons);
     s->phase_polygon_area = mesh->region_area[mesh->ngrains];
 }
