@@ -589,7 +589,8 @@ static int by_edge_position(const void *a, const void *b)
 
 static int outline_segments(builder *b)
 {
-    qsort(b->extra, b->nextra, sizeof *b->extra, by_edge_position);
+    if (b->nextra) /* no array at all when no point fell on another outline's edge */
+        qsort(b->extra, b->nextra, sizeof *b->extra, by_edge_position);
     size_t e = 0;
     for (size_t p = 0; p < b->npoly; p++) {
         size_t begin = b->rstart[p], n = b->rstart[p + 1] - begin;
