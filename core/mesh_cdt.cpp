@@ -69,6 +69,14 @@ public:
         typedef Face_base<Gt, Fb2> Other;
     };
     using Fb::Fb;
+    // User-provided, as CGAL's own face bases are: the container makes a face with
+    // `new (slot) Face_base()`, which would zero-initialize an implicit constructor's
+    // object, time stamp included, and the container keeps any stamp but -1 (the one
+    // a fresh slot holds). Every face from Tds::create_face() (hole filling when a
+    // segment or a point goes in) then had stamp 0: handles order by stamp, so two of
+    // them compared equal (Debug: Time_stamper.h's assertion; Release: the edge
+    // iterator may skip the edge between two such faces).
+    Face_base() : Fb() {}
     std::ptrdiff_t queue_pos = -1;
     int32_t region = -1;
 };
