@@ -1,4 +1,4 @@
-/* io_format.c - result format names, media types and dispatch. */
+/* io_format.c - result format names and media types. */
 #include <string.h>
 
 #include "grainpack/io.h"
@@ -6,35 +6,22 @@
 
 static const struct {
     const char *name, *media_type;
+    int text;
 } formats[] = {
-    [GP_FORMAT_JSON] = {"json", "application/json"},
-    [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8"},
-    [GP_FORMAT_SVG] = {"svg", "image/svg+xml"},
+    [GP_FORMAT_JSON] = {"json", "application/json", 1},
+    [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8", 1},
+    [GP_FORMAT_SVG] = {"svg", "image/svg+xml", 1},
     /* legacy VTK has no registered media type; this is the one in common use */
-    [GP_FORMAT_VTK] = {"vtk", "application/x-vtk"},
+    [GP_FORMAT_VTK] = {"vtk", "application/x-vtk", 1},
     /* none of the three has a registered media type: these are the descriptive x- ones */
-    [GP_FORMAT_MSH] = {"msh", "text/x-gmsh; charset=utf-8"},
-    [GP_FORMAT_INP] = {"inp", "text/x-abaqus-input; charset=utf-8"},
-    [GP_FORMAT_VTU] = {"vtu", "application/x-vtu+xml"},
+    [GP_FORMAT_MSH] = {"msh", "text/x-gmsh; charset=utf-8", 1},
+    [GP_FORMAT_INP] = {"inp", "text/x-abaqus-input; charset=utf-8", 1},
+    [GP_FORMAT_VTU] = {"vtu", "application/x-vtu+xml", 1},
 };
 
 int gp_format_needs_mesh(gp_format format)
 {
     return format == GP_FORMAT_MSH || format == GP_FORMAT_INP;
-}
-
-/* A gp_out writer on a FILE. */
-static int write_out(FILE *out, int (*writer)(gp_out *, const gp_spec *, const gp_result *),
-                     const gp_spec *spec, const gp_result *result)
-{
-    gp_out o;
-    if (gp_out_init_file(&o, out))
-        return GP_ENOMEM;
-    int rc = writer(&o, spec, result);
-    if (rc == 0)
-        rc = gp_out_flush(&o);
-    gp_out_free(&o);
-    return rc;
 }
 
 int gp_format_parse(const char *name, gp_format *out)
@@ -63,16 +50,7 @@ const char *gp_format_media_type(gp_format format)
     return formats[format].media_type;
 }
 
-int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result)
+int gp_format_is_text(gp_format format)
 {
-    switch (format) {
-    case GP_FORMAT_JSON: return gp_write_json(out, spec, result);
-    case GP_FORMAT_CSV: return gp_write_csv(out, result);
-    case GP_FORMAT_SVG: return gp_write_svg(out, spec, result);
-    case GP_FORMAT_VTK: return gp_write_vtk(out, spec, result);
-    case GP_FORMAT_MSH: return write_out(out, gp_write_msh, spec, result);
-    case GP_FORMAT_INP: return write_out(out, gp_write_inp, spec, result);
-    case GP_FORMAT_VTU: return write_out(out, gp_write_vtu, spec, result);
-    }
-    return GP_EINVAL;
+    return formats[format].text;
 }

@@ -33,6 +33,11 @@
 #define BODY_DEADLINE_FACTOR 2
 /* The listen queue: enough for a burst of a few hundred clients connecting at once. */
 #define LISTEN_BACKLOG 1024
+/* The buffer of a streamed response (a result download), filled by its producer each
+ * time the socket has taken the last one: large enough that a callback's fixed cost
+ * (a store connection, a window of the result) is spread over many bytes, small enough
+ * that 20 downloads at once hold a few megabytes. */
+#define STREAM_BLOCK ((size_t)128 * 1024)
 
 /* Per-request state, from the first call of a request to its completion. */
 typedef struct request_state {
@@ -107,7 +112,8 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     if (!any)
         MHD_add_response_header(resp, "Vary", "Origin");
     MHD_add_response_header(resp, "Access-Control-Expose-Headers",
-                            "Location, Retry-After, Content-Type, WWW-Authenticate");
+                            "Location, Retry-After, Content-Type, WWW-Authenticate, ETag, "
+                            "Content-Disposition");
     if (preflight && rt) {
         char allow[64];
         gp_router_allow(rt, allow, sizeof allow);
@@ -118,13 +124,37 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     }
 }
 
-/* A response holding reply's body (it is the response's once this returns non-NULL). */
+/* libmicrohttpd's reader of a streamed body: gp_body_stream's fill, in its terms. */
+static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    (void)pos;
+    gp_body_stream *s = cls;
+    long n = s->fill(s, buf, max);
+    return n > 0 ? (ssize_t)n : n == 0 ? MHD_CONTENT_READER_END_OF_STREAM
+                                       : MHD_CONTENT_READER_END_WITH_ERROR;
+}
+
+static void stream_release(void *cls)
+{
+    gp_body_stream *s = cls;
+    s->release(s);
+}
+
+/* A response taking reply's body or stream (the response's once this returns non-NULL);
+ * NULL when out of memory. */
 static struct MHD_Response *create_response(gp_reply *reply)
 {
+    struct MHD_Response *resp;
+    if (reply->stream) {
+        resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, STREAM_BLOCK, stream_read,
+                                                 reply->stream, stream_release);
+        if (resp)
+            reply->stream = NULL;
+        return resp;
+    }
     int owned = reply->body && !reply->persistent;
-    struct MHD_Response *resp = MHD_create_response_from_buffer(
-        reply->len, reply->body ? reply->body : (void *)"",
-        owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+    resp = MHD_create_response_from_buffer(reply->len, reply->body ? reply->body : (void *)"",
+                                           owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
     if (resp && owned)
         reply->body = NULL;
     return resp;
@@ -156,6 +186,8 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
         snprintf(seconds, sizeof seconds, "%d", reply->retry_after);
         MHD_add_response_header(resp, "Retry-After", seconds);
     }
+    for (int i = 0; i < reply->nheaders; i++)
+        MHD_add_response_header(resp, reply->headers[i].name, reply->headers[i].value);
     if (reply->close)
         MHD_add_response_header(resp, "Connection", "close");
     if (reply->vary)

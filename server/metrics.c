@@ -31,6 +31,9 @@ typedef struct stage_histogram {
 struct gp_metrics {
     atomic_ulong requests[600]; /* by status code */
     atomic_ulong outcomes[NOUTCOMES];
+    atomic_ulong pipeline_runs;   /* gp_pipeline_run calls (and rederivations) */
+    atomic_long downloads;        /* result downloads streaming now */
+    atomic_ulong downloads_total; /* result downloads started */
     pthread_mutex_t stage_lock; /* taken only to claim a histogram for a new stage name */
     stage_histogram stages[GP_MAX_STAGES];
 };
@@ -55,6 +58,18 @@ void gp_metrics_request(gp_metrics *m, unsigned status)
 {
     if (status < 600)
         atomic_fetch_add(&m->requests[status], 1);
+}
+
+void gp_metrics_pipeline_run(gp_metrics *m)
+{
+    atomic_fetch_add(&m->pipeline_runs, 1);
+}
+
+void gp_metrics_download(gp_metrics *m, int delta)
+{
+    atomic_fetch_add(&m->downloads, delta);
+    if (delta > 0)
+        atomic_fetch_add(&m->downloads_total, 1);
 }
 
 void gp_metrics_outcome(gp_metrics *m, const char *outcome)
@@ -130,6 +145,16 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
     for (size_t i = 0; i < NOUTCOMES; i++)
         fprintf(f, "grainpack_job_runs_total{outcome=\"%s\"} %lu\n", outcome_names[i],
                 atomic_load(&m->outcomes[i]));
+    fprintf(f,
+            "# HELP grainpack_pipeline_runs_total Runs of the job pipeline (packing and the "
+            "stages after it) in this process: workers only; a download renders what is stored.\n"
+            "# TYPE grainpack_pipeline_runs_total counter\ngrainpack_pipeline_runs_total %lu\n"
+            "# HELP grainpack_downloads Result downloads being streamed now.\n"
+            "# TYPE grainpack_downloads gauge\ngrainpack_downloads %ld\n"
+            "# HELP grainpack_downloads_total Result downloads started (304 answers not counted).\n"
+            "# TYPE grainpack_downloads_total counter\ngrainpack_downloads_total %lu\n",
+            atomic_load(&m->pipeline_runs), atomic_load(&m->downloads),
+            atomic_load(&m->downloads_total));
     fputs("# HELP grainpack_stage_duration_seconds Wall-clock time of pipeline stages.\n"
           "# TYPE grainpack_stage_duration_seconds histogram\n",
           f);

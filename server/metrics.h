@@ -22,6 +22,14 @@ void gp_metrics_request(gp_metrics *m, unsigned status);
  * DELETE: result dropped) or "requeued". */
 void gp_metrics_outcome(gp_metrics *m, const char *outcome);
 
+/* The job pipeline is about to run (a worker), or a stored result's stages to be derived
+ * again (the migration of a version 2 database): counted so that a test can tell that a
+ * download ran none. */
+void gp_metrics_pipeline_run(gp_metrics *m);
+
+/* A result download started (delta 1) or ended (delta -1). */
+void gp_metrics_download(gp_metrics *m, int delta);
+
 /* A pipeline stage took `seconds` (histogram per stage name; names are static strings
  * from the engine, at most GP_MAX_STAGES of them are tracked). */
 void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds);

@@ -104,6 +104,11 @@ static const char out_of_memory_body[] =
 
 void gp_problem_out_of_memory(gp_reply *reply)
 {
+    if (reply->stream) { /* a download that could not start: its body and headers go */
+        reply->stream->release(reply->stream);
+        reply->stream = NULL;
+    }
+    reply->nheaders = 0;
     gp_reply_take(reply, 503, GP_PROBLEM_MEDIA_TYPE, (char *)out_of_memory_body,
                   sizeof out_of_memory_body - 1);
     reply->persistent = 1;

@@ -49,9 +49,11 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                   " grain_fraction = ?6, r_min = ?7, r_max = ?8, r_mean = ?9, chi2 = ?10,"
                   " dof = ?11, p_value = ?12, max_abs_z = ?13, initial_disks = ?14,"
                   " front_attempts = ?15, front_closures = ?16, front_frozen = ?17,"
-                  " front_capped = ?18, max_level = ?19"
+                  " front_capped = ?18, max_level = ?19, result_version = ?20"
                   " WHERE id = ?1 AND status = 'running'",
-    [ST_RESULT] = "INSERT OR REPLACE INTO results (job_id, count, disks) VALUES (?1, ?2, ?3)",
+    [ST_SECTION] = "INSERT INTO result_sections (job_id, tag, version, bytes, summary)"
+                   " VALUES (?1, ?2, ?3, ?4, ?5) RETURNING id",
+    [ST_CHUNK] = "INSERT INTO result_chunks (section, chunk, data) VALUES (?1, ?2, ?3)",
     [ST_BIN] = "INSERT OR REPLACE INTO bin_stats (job_id, bin, min, max, target, achieved, count, z)"
                " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
     [ST_TIMING] = "INSERT OR REPLACE INTO stage_timings (job_id, position, stage, seconds)"
@@ -64,10 +66,13 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
     [ST_DISMISS] = "UPDATE jobs SET status = 'dismissed', message = ?2, finished = ?3, updated = ?3"
                    " WHERE id = ?1 AND status IN ('accepted', 'running')",
     [ST_DELETE] = "DELETE FROM jobs WHERE id = ?1",
-    [ST_LOAD] = "SELECT j.spec, r.count, r.disks, j.initial_disks, j.front_attempts,"
-                " j.front_closures, j.front_frozen, j.front_capped, j.max_level"
-                " FROM jobs j JOIN results r ON r.job_id = j.id"
-                " WHERE j.id = ?1 AND j.status = 'successful' AND (?2 IS NULL OR j.owner = ?2)",
+    [ST_OPEN_RESULT] = "SELECT seq, spec, result_version FROM jobs"
+                       " WHERE id = ?1 AND status = 'successful' AND (?2 IS NULL OR owner = ?2)",
+    [ST_SUMMARY_SECTIONS] = "SELECT tag, version, id, bytes FROM result_sections"
+                            " WHERE job_id = ?1 AND summary = 1 ORDER BY id",
+    [ST_FIND_SECTION] = "SELECT s.id, s.bytes FROM result_sections s JOIN jobs j ON j.id = s.job_id"
+                        " WHERE j.seq = ?1 AND s.tag = ?2",
+    [ST_READ_CHUNK] = "SELECT data FROM result_chunks WHERE section = ?1 AND chunk = ?2",
     [ST_TIMINGS] = "SELECT stage, seconds FROM stage_timings WHERE job_id = ?1 ORDER BY position",
     [ST_COUNT] = "SELECT status, count(*) FROM jobs GROUP BY status",
     [ST_ACTIVE] = "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('accepted', 'running')",
@@ -298,6 +303,7 @@ static int migrate(gp_db *db, char *why, size_t why_size)
         char set_version[48];
         snprintf(set_version, sizeof set_version, "PRAGMA user_version = %d", version + 1);
         if (exec_sql(db->conn, gp_store_migrations[version], why, why_size) ||
+            (gp_store_conversions[version] && gp_store_conversions[version](db, why, why_size)) ||
             exec_sql(db->conn, set_version, why, why_size) ||
             exec_sql(db->conn, "COMMIT", why, why_size)) {
             char ignored[8];

@@ -28,16 +28,21 @@ int gp_job_status_parse(const char *name, gp_job_status *out)
     return GP_EINVAL;
 }
 
+void gp_db_random_bytes(void *buf, size_t len)
+{
+    size_t got = 0;
+    while (got < len) {
+        ssize_t n = getrandom((unsigned char *)buf + got, len - got, 0);
+        if (n > 0)
+            got += (size_t)n;
+    }
+}
+
 /* A random (version 4) UUID: job ids must not be guessable from one another. */
 static void new_job_id(char out[GP_JOB_ID_SIZE])
 {
     unsigned char b[16];
-    size_t got = 0;
-    while (got < sizeof b) {
-        ssize_t n = getrandom(b + got, sizeof b - got, 0);
-        if (n > 0)
-            got += (size_t)n;
-    }
+    gp_db_random_bytes(b, sizeof b);
     b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
     b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
     snprintf(out, GP_JOB_ID_SIZE,

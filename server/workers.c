@@ -269,6 +269,7 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
            on may be off; gp_spec.max_elements) */
         spec.max_elements = svc->cfg->max_elements;
         gp_progress progress = {report_progress, w, &w->cancel};
+        gp_metrics_pipeline_run(svc->metrics);
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
     }
     conclude(w, id, rc, &result, &err);

@@ -12,6 +12,7 @@
 #include "check.h"
 #include "grainpack/balance.h"
 #include "grainpack/io.h"
+#include "render_checks.h"
 #include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
 #include "packing_checks.h"
@@ -413,12 +414,7 @@ static size_t read_vtk(char *text, const gp_disk *d, size_t n)
 
 static char *render(gp_format format, const gp_spec *spec, const gp_result *r)
 {
-    char *buf = NULL;
-    size_t len;
-    FILE *f = open_memstream(&buf, &len);
-    CHECK(gp_write_result(f, format, spec, r) == 0);
-    fclose(f);
-    return buf;
+    return render_text(format, spec, r, NULL);
 }
 
 static void test_vtk_and_json_carry_every_cell(void)

@@ -5,10 +5,13 @@ larger than --max-elements are 422 with the field's pointer, before anything is 
 runs in a worker, and its results download as msh, inp and vtu: byte for byte what
 `grainpack run` writes for the same spec, read back by meshio with the counts of the
 job's statistics, and listed as links only for a job that has a mesh (msh and inp of a
-job without one are 400; its vtu is the grains, which meshio reads). Responses are
-checked against openapi.yaml.
+job without one are 400; its vtu is the grains, which meshio reads). The downloads
+(msh, inp, vtu plain and gzip, svg, json, statistics) render the stored sections: the
+daemon's grainpack_pipeline_runs_total does not move. Responses are checked against
+openapi.yaml.
 Usage: test_service_mesh.py GRAINPACKD GRAINPACK"""
 
+import gzip
 import json
 import os
 import subprocess
@@ -113,6 +116,7 @@ def check_downloads(c, api, client, cli, tmp):
     spec_path = os.path.join(tmp, "spec.json")
     with open(spec_path, "w") as f:
         json.dump(spec, f)
+    runs = pipeline_runs(client)
     for fmt in ("msh", "inp", "vtu"):
         r = client.get(links[fmt]["href"])
         c.check(r.status == 200 and r.content_type == MEDIA[fmt] == links[fmt]["type"].split(";")[0],
@@ -132,9 +136,28 @@ def check_downloads(c, api, client, cli, tmp):
         if fmt == "vtu":
             phase = np.concatenate(m.cell_data["phase"])
             c.check(set(np.unique(phase)) == {0, 1}, f"vtu phases {np.unique(phase)}")
+        # text: gzip on the wire when accepted, the same bytes once decompressed
+        z = client.get(links[fmt]["href"], headers={"Accept-Encoding": "gzip"})
+        c.check(z.status == 200 and z.headers.get("content-encoding") == "gzip"
+                and gzip.decompress(z.body) == made and len(z.body) < len(made),
+                f"{fmt} gzip: {z.status} {z.headers.get('content-encoding')}, {len(z.body)} bytes")
+    # the picture draws the stored mesh: the command line's bytes
+    r = client.get(f"/jobs/{job}/results?f=svg")
+    made = subprocess.run([cli, "run", spec_path, "-f", "svg"], capture_output=True, check=True).stdout
+    c.check(r.status == 200 and r.body == made and b"mesh:" in made,
+            f"svg: the download ({len(r.body)} bytes) is not what grainpack run writes ({len(made)})")
+    r = client.get(f"/jobs/{job}/results?f=json")
+    c.check(r.status == 200 and r.json()["statistics"]["mesh"]["nodes"] == st["nodes"], f"json: {r}")
+    # every download above rendered the stored sections: no pipeline ran for them
+    c.check(pipeline_runs(client) == runs, f"downloads ran the pipeline: {runs} runs before, "
+            f"{pipeline_runs(client)} after")
     # the same job through Accept instead of ?f=
     r = client.get(f"/jobs/{job}/results", headers={"Accept": "text/x-gmsh"})
     c.check(r.status == 200 and r.content_type == "text/x-gmsh", f"Accept: text/x-gmsh: {r}")
+
+
+def pipeline_runs(client):
+    return gpd.metric(client.get("/metrics").body.decode(), "grainpack_pipeline_runs_total")
 
 
 def check_without_mesh(c, api, client, tmp):

@@ -78,7 +78,7 @@ def test(c, binary):
 
         with daemon.db() as db:
             c.check(db.execute("PRAGMA integrity_check").fetchone()[0] == "ok", "integrity_check")
-            c.check(db.execute("PRAGMA user_version").fetchone()[0] == 2, "schema version")
+            c.check(db.execute("PRAGMA user_version").fetchone()[0] == 3, "schema version")
             n = db.execute("SELECT count(*) FROM jobs WHERE status = 'successful'").fetchone()[0]
             c.check(n == len(ids) + 1, f"{n} successful jobs")
     finally:
