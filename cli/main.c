@@ -15,21 +15,27 @@ enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2, EXIT_BAD_SPEC = 3 };
 
 static void usage(FILE *out)
 {
-    fputs("Usage: grainpack run SPEC.json [--format json|csv|svg|vtk] [-o FILE] [--max-disks N]\n"
-          "  or:  grainpack validate SPEC.json [--max-disks N]\n"
+    fputs("Usage: grainpack run SPEC.json [--format FORMAT] [-o FILE] [--max-disks N]\n"
+          "                     [--max-elements N]\n"
+          "  or:  grainpack validate SPEC.json [--max-disks N] [--max-elements N]\n"
           "  or:  grainpack --help | --version\n"
           "\n"
-          "  run       packs the domain the spec describes, balances it and builds its\n"
-          "            Laguerre cells when the spec asks (\"balance\", \"laguerre\"), and\n"
-          "            writes the result (default JSON with statistics, to standard output).\n"
+          "  run       packs the domain the spec describes, balances it, builds its\n"
+          "            Laguerre cells and meshes it when the spec asks (\"balance\",\n"
+          "            \"laguerre\", \"mesh\"), and writes the result (default JSON with\n"
+          "            statistics, to standard output).\n"
           "            SPEC.json is the job spec, either {\"inputs\": {...}} or the bare\n"
           "            inputs object; '-' reads stdin.\n"
           "  validate  checks a spec and prints the expected number of disks.\n"
           "\n"
-          "  -f, --format FORMAT  json (default), csv, svg or vtk\n"
+          "  -f, --format FORMAT  json (default), csv, svg, vtk (legacy VTK), or\n"
+          "                       vtu (VTK XML: the mesh, else the grains), msh (Gmsh 4.1),\n"
+          "                       inp (Abaqus); msh and inp need \"mesh\" in the spec\n"
           "  -o FILE              write to FILE instead of standard output\n"
           "  --max-disks N        refuse specs expected to need more than N disks\n"
           "                       (default 20000000)\n"
+          "  --max-elements N     refuse meshes expected to need more than N elements,\n"
+          "                       and stop a mesh that grows beyond (default 20000000)\n"
           "\n"
           "Progress goes to standard error when it is a terminal.\n"
           "Exit status: 0 success, 1 the run failed, 2 usage error, 3 invalid spec.\n",
@@ -52,9 +58,9 @@ static void show_progress(void *ctx, const char *stage, double fraction)
     fflush(stderr);
 }
 
-static int load_spec(const char *path, size_t max_disks, gp_spec *spec)
+static int load_spec(const char *path, size_t max_disks, size_t max_elements, gp_spec *spec)
 {
-    gp_spec_limits limits = {.max_disks = max_disks};
+    gp_spec_limits limits = {.max_disks = max_disks, .max_elements = max_elements};
     gp_error err;
     gp_error_clear(&err);
     int rc = strcmp(path, "-") == 0 ? gp_spec_load_file("/dev/stdin", &limits, spec, &err)
@@ -68,12 +74,19 @@ static int load_spec(const char *path, size_t max_disks, gp_spec *spec)
     return rc == GP_EIO || rc == GP_ENOMEM ? EXIT_FAILED : EXIT_BAD_SPEC;
 }
 
-static int run(const char *spec_path, gp_format format, const char *out_path, size_t max_disks)
+static int run(const char *spec_path, gp_format format, const char *out_path, size_t max_disks,
+               size_t max_elements)
 {
     gp_spec spec;
-    int status = load_spec(spec_path, max_disks, &spec);
+    int status = load_spec(spec_path, max_disks, max_elements, &spec);
     if (status)
         return status;
+    if (gp_format_needs_mesh(format) && !spec.mesh_enabled) {
+        fprintf(stderr, "grainpack: %s: --format %s needs a mesh: add \"mesh\": {} to the spec\n",
+                spec_path, gp_format_name(format));
+        gp_spec_free(&spec);
+        return EXIT_USAGE;
+    }
 
     terminal_progress tp = {-1};
     gp_progress progress = {show_progress, &tp, NULL};
@@ -102,6 +115,12 @@ static int run(const char *spec_path, gp_format format, const char *out_path, si
             fprintf(stderr, "grainpack: %zu cells (%s), boundary band %.4f of the domain, %.1f ms\n",
                     result.cell_stats.count, gp_shrink_name(result.cells.shrink),
                     result.cell_stats.band_fraction, 1e3 * gp_result_stage_seconds(&result, "laguerre"));
+        if (result.has_mesh)
+            fprintf(stderr, "grainpack: mesh: %zu nodes, %zu triangles, %zu quadrilaterals, angles "
+                            "%.2f to %.2f degrees, %.1f ms\n",
+                    result.mesh.stats.nodes, result.mesh.stats.triangles, result.mesh.stats.quads,
+                    result.mesh.stats.min_angle, result.mesh.stats.max_angle,
+                    1e3 * gp_result_stage_seconds(&result, "mesh"));
     }
 
     FILE *out = out_path ? fopen(out_path, "wb") : stdout;
@@ -131,13 +150,16 @@ static int run(const char *spec_path, gp_format format, const char *out_path, si
     return status;
 }
 
-static int validate(const char *spec_path, size_t max_disks)
+static int validate(const char *spec_path, size_t max_disks, size_t max_elements)
 {
     gp_spec spec;
-    int status = load_spec(spec_path, max_disks, &spec);
+    int status = load_spec(spec_path, max_disks, max_elements, &spec);
     if (status)
         return status;
-    printf("%s: valid, about %.0f disks expected\n", spec_path, spec.expected_disks);
+    printf("%s: valid, about %.0f disks expected", spec_path, spec.expected_disks);
+    if (spec.mesh_enabled)
+        printf(", about %.0f mesh elements", spec.expected_elements);
+    putchar('\n');
     gp_spec_free(&spec);
     return EXIT_OK;
 }
@@ -169,7 +191,7 @@ int main(int argc, char **argv)
     }
     const char *command = argv[1], *spec_path = NULL, *out_path = NULL;
     gp_format format = GP_FORMAT_JSON;
-    size_t max_disks = 0;
+    size_t max_disks = 0, max_elements = 0;
     if (strcmp(command, "run") != 0 && strcmp(command, "validate") != 0) {
         fprintf(stderr, "grainpack: unknown command '%s'\n", command);
         usage(stderr);
@@ -180,7 +202,8 @@ int main(int argc, char **argv)
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         if ((strcmp(arg, "--format") == 0 || strcmp(arg, "-f") == 0) && value) {
             if (gp_format_parse(value, &format)) {
-                fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg or vtk)\n", value);
+                fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg, vtk, vtu, msh "
+                                "or inp)\n", value);
                 return EXIT_USAGE;
             }
             i++;
@@ -190,6 +213,13 @@ int main(int argc, char **argv)
         } else if (strcmp(arg, "--max-disks") == 0 && value) {
             if (parse_count(value, &max_disks)) {
                 fprintf(stderr, "grainpack: --max-disks expects a positive integer, got '%s'\n", value);
+                return EXIT_USAGE;
+            }
+            i++;
+        } else if (strcmp(arg, "--max-elements") == 0 && value) {
+            if (parse_count(value, &max_elements)) {
+                fprintf(stderr, "grainpack: --max-elements expects a positive integer, got '%s'\n",
+                        value);
                 return EXIT_USAGE;
             }
             i++;
@@ -207,6 +237,6 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     if (strcmp(command, "validate") == 0)
-        return validate(spec_path, max_disks);
-    return run(spec_path, format, out_path, max_disks);
+        return validate(spec_path, max_disks, max_elements);
+    return run(spec_path, format, out_path, max_disks, max_elements);
 }

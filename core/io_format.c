@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "grainpack/io.h"
+#include "grainpack/io_mesh.h"
 
 static const struct {
     const char *name, *media_type;
@@ -12,7 +13,16 @@ static const struct {
     [GP_FORMAT_SVG] = {"svg", "image/svg+xml", 1},
     /* legacy VTK has no registered media type; this is the one in common use */
     [GP_FORMAT_VTK] = {"vtk", "application/x-vtk", 1},
+    /* none of the three has a registered media type: these are the descriptive x- ones */
+    [GP_FORMAT_MSH] = {"msh", "text/x-gmsh; charset=utf-8", 1},
+    [GP_FORMAT_INP] = {"inp", "text/x-abaqus-input; charset=utf-8", 1},
+    [GP_FORMAT_VTU] = {"vtu", "application/x-vtu+xml", 1},
 };
+
+int gp_format_needs_mesh(gp_format format)
+{
+    return format == GP_FORMAT_MSH || format == GP_FORMAT_INP;
+}
 
 int gp_format_parse(const char *name, gp_format *out)
 {

@@ -6,6 +6,7 @@
 
 #include "json_values.h"
 #include "writer.h"
+#include "io_mesh_json.h"
 
 /* json_object_set_new that remembers a failure instead of returning it at every call. */
 static void put(json_t *obj, const char *key, json_t *value, int *failed)
@@ -188,6 +189,8 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
         put(root, "balance", balance_json(&result->balance, &failed), &failed);
     if (result->has_cells)
         put(root, "cells", cells_json(spec, &result->cell_stats, &failed), &failed);
+    if (result->has_mesh)
+        put(root, "mesh", gp_mesh_statistics_json(spec, &result->mesh), &failed);
     if (failed) {
         json_decref(root);
         return NULL;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "writer.h"
+#include "io_svg_mesh.h"
 
 /* Colour classes of the scale; more would not be told apart on screen. */
 #define COLOR_CLASSES 16
@@ -217,7 +218,7 @@ static void head(gp_writer *w, gp_out *out, int param)
     double L = W > H ? W : H;
     int dec = st->dec;
     double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
-    double legend_h = bar_h + (3.5 + 1.4 * (w->result->has_balance + w->result->has_cells)) * font;
+    double legend_h = bar_h + (3.5 + 1.4 * (w->result->has_balance + w->result->has_cells + w->result->has_mesh)) * font;
     double vw = W + 2 * margin, vh = H + 2 * margin + legend_h;
     double px = PICTURE_PX / L;
     gp_out_puts(out, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -246,6 +247,14 @@ static void head(gp_writer *w, gp_out *out, int param)
     domain_rect(w, out, "\" fill=\"" BACKGROUND "\"/>\n");
     if (w->result->has_cells) /* the band between the cells */
         domain_rect(w, out, "\" fill=\"" JOINT "\"/>\n");
+}
+
+/* The mesh's edges over the grains (nothing when too fine to draw). */
+static void mesh_edges(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    gp_svg_mesh(out, w->result, st->H, st->dec);
 }
 
 /* The domain's outline, the colour bar, its labels, and a caption of what the picture
@@ -308,6 +317,13 @@ static void legend(gp_writer *w, gp_out *out, int param)
         gp_out_printf(out, ">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
                       gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);
     }
+    if (result->has_mesh) {
+        const gp_mesh_stats *ms = &result->mesh.stats;
+        attr(out, "<text x=\"0\" y=\"", line_y += 1.4 * font, dec);
+        gp_out_printf(out, ">mesh%s: %zu triangles, %zu quadrilaterals, %zu nodes, angles %.1f to %.1f degrees</text>\n",
+                      gp_svg_mesh_drawable(&result->mesh) ? "" : " (too fine to draw)",
+                      ms->triangles, ms->quads, ms->nodes, ms->min_angle, ms->max_angle);
+    }
     GP_OUT_LITERAL(out, "</g>\n</svg>\n");
 }
 
@@ -336,6 +352,8 @@ int gp_plan_svg(gp_writer *w)
         gp_writer_grains(w, outline, GP_GRAINS_DISKS, 0);
         gp_writer_text(w, close_group, 0);
     }
+    if (w->result->has_mesh)
+        gp_writer_text(w, mesh_edges, 0);
     gp_writer_text(w, legend, 0);
     return 0;
 }

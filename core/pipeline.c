@@ -1,7 +1,8 @@
-/* pipeline.c - spec -> packing -> (balance, Laguerre cells) -> statistics, timing each
- * stage. */
+/* pipeline.c - spec -> packing -> (balance, Laguerre cells, mesh) -> statistics, timing
+ * each stage. */
 #include "grainpack/pipeline.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -28,6 +29,23 @@ static int between_stages(const gp_progress *progress, const char *next, gp_erro
     return 0;
 }
 
+static int mesh(const gp_spec *spec, gp_result *result, const gp_rt *rt,
+                const gp_progress *progress, gp_error *err)
+{
+    gp_mesh_input in = {
+        .domain = &spec->domain,
+        .disks = result->packing.disks,
+        .ndisks = result->packing.count,
+        .cells = result->has_cells ? &result->cells : NULL,
+        .rt = rt,
+        .max_elements = spec->max_elements > SIZE_MAX / GP_MESH_CAP_SLACK
+                            ? SIZE_MAX : spec->max_elements * GP_MESH_CAP_SLACK,
+    };
+    int rc = gp_mesh_build(&in, &spec->mesh, progress, &result->mesh, err);
+    result->has_mesh = rc == 0;
+    return rc;
+}
+
 int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
                     gp_result *result, gp_error *err)
 {
@@ -41,8 +59,9 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
         goto fail;
     record(result, "pack", t0);
 
-    if (spec->balance_enabled || spec->laguerre_enabled) {
-        /* one triangulation serves both stages: balancing keeps it up to date */
+    if (spec->balance_enabled || spec->laguerre_enabled || spec->mesh_enabled) {
+        /* one triangulation serves every stage: balancing keeps it up to date; the mesh of
+           disks in a matrix finds their contacts in it */
         t0 = now_seconds();
         if ((rc = between_stages(progress, "triangulation", err)) ||
             (rc = gp_rt_build(pk->disks, pk->count, progress, &rt, err)))
@@ -67,6 +86,12 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
             goto fail;
         result->has_cells = 1;
         record(result, "laguerre", t0);
+    }
+    if (spec->mesh_enabled) {
+        t0 = now_seconds();
+        if ((rc = mesh(spec, result, rt, progress, err)))
+            goto fail;
+        record(result, "mesh", t0);
     }
     gp_rt_free(rt);
     rt = NULL;
@@ -96,7 +121,7 @@ fail:
 int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
 {
     gp_packing *pk = &result->packing;
-    if (!spec->balance_enabled && !spec->laguerre_enabled)
+    if (!spec->balance_enabled && !spec->laguerre_enabled && !spec->mesh_enabled)
         return 0;
     gp_rt *rt;
     int rc = gp_rt_build(pk->disks, pk->count, NULL, &rt, err);
@@ -126,6 +151,8 @@ int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
         }
         result->has_cells = rc == 0;
     }
+    if (rc == 0 && spec->mesh_enabled)
+        rc = mesh(spec, result, rt, NULL, err);
     gp_rt_free(rt);
     return rc;
 }
@@ -137,6 +164,7 @@ void gp_result_free(gp_result *result)
     gp_balance_result_free(&result->balance);
     gp_cells_free(&result->cells);
     gp_cell_stats_free(&result->cell_stats);
+    gp_mesh_free(&result->mesh);
     memset(result, 0, sizeof *result);
 }
 

@@ -165,6 +165,42 @@ static int encode_cell_sizes(enc *e, const gp_cells *c)
     return 0;
 }
 
+/* The mesh's summary: kind, order, counts, each region's polygon area, its statistics. */
+static void encode_mesh(enc *e, const gp_mesh *m)
+{
+    const gp_mesh_stats *s = &m->stats;
+    put_u32(e, (uint32_t)m->kind);
+    put_u32(e, (uint32_t)m->order);
+    put_u64(e, m->ngrains);
+    put_u64(e, m->nnodes);
+    put_u64(e, m->ntri);
+    put_u64(e, m->nquad);
+    put_u64(e, m->nbedges);
+    for (size_t i = 0; i <= m->ngrains; i++)
+        put_f64(e, m->region_area[i]);
+    put_u64(e, s->nodes);
+    put_u64(e, s->triangles);
+    put_u64(e, s->quads);
+    put_u64(e, s->boundary_edges);
+    put_f64(e, s->min_angle);
+    put_f64(e, s->max_angle);
+    put_u64(e, s->below_min_angle);
+    put_f64(e, s->min_input_angle);
+    put_f64(e, s->quality_min);
+    put_f64(e, s->quality_mean);
+    put_counts(e, s->quality_histogram, GP_MESH_QUALITY_BINS);
+    put_f64(e, s->domain_area);
+    put_f64(e, s->element_area);
+    put_f64(e, s->grain_area);
+    put_f64(e, s->grain_polygon_area);
+    put_f64(e, s->phase_area);
+    put_f64(e, s->phase_polygon_area);
+    put_u64(e, s->band_strips);
+    put_f64(e, s->band_thickness_min);
+    put_f64(e, s->band_thickness_mean);
+    put_u64(e, s->refused_refinements);
+}
+
 /* Adds a section: borrowed bytes (e == NULL), or the encoder's (taken over). */
 static void add(gp_section *s, size_t *n, const char *tag, int summary, const void *data,
                 size_t size, enc *e)
@@ -223,6 +259,24 @@ int gp_sections_from_result(const gp_result *r, gp_section *s, size_t *n)
         add(s, n, GP_SECTION_CELL_AREA, 0, c->area, c->count * sizeof(double), NULL);
         add(s, n, GP_SECTION_CELL_NEIGHBOURS, 0, c->neighbours,
             c->nstart[c->count] * sizeof(int32_t), NULL);
+    }
+    if (r->has_mesh) {
+        const gp_mesh *m = &r->mesh;
+        e = (enc){0};
+        encode_mesh(&e, m);
+        if (e.failed)
+            goto fail;
+        add(s, n, GP_SECTION_MESH, 1, NULL, 0, &e);
+        add(s, n, GP_SECTION_MESH_XY, 0, m->xy, 2 * m->nnodes * sizeof(double), NULL);
+        add(s, n, GP_SECTION_MESH_TRI, 0, m->tri,
+            m->ntri * (size_t)gp_mesh_tri_nodes(m->order) * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_MESH_TRI_REGION, 0, m->tri_region, m->ntri * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_MESH_QUAD, 0, m->quad,
+            m->nquad * (size_t)gp_mesh_quad_nodes(m->order) * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_MESH_QUAD_REGION, 0, m->quad_region, m->nquad * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_MESH_BEDGE, 0, m->bedge,
+            m->nbedges * (size_t)(m->order + 1) * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_MESH_BEDGE_SIDE, 0, m->bedge_side, m->nbedges, NULL);
     }
     return 0;
 fail:
@@ -407,6 +461,52 @@ static int decode_cells(dec *d, gp_result *r)
     return rc;
 }
 
+static int decode_mesh(dec *d, gp_result *r)
+{
+    gp_mesh *m = &r->mesh;
+    gp_mesh_free(m);
+    gp_mesh_stats *s = &m->stats;
+    m->kind = (gp_mesh_kind)get_u32(d);
+    m->order = (int)get_u32(d);
+    m->ngrains = get_count(d, sizeof(double));
+    m->nnodes = get_size(d);
+    m->ntri = get_size(d);
+    m->nquad = get_size(d);
+    m->nbedges = get_size(d);
+    if (m->order != 1 && m->order != 2)
+        d->failed = 1;
+    if (d->failed)
+        return 0;
+    m->region_area = calloc(m->ngrains + 1, sizeof *m->region_area);
+    if (!m->region_area)
+        return GP_ENOMEM;
+    for (size_t i = 0; i <= m->ngrains; i++)
+        m->region_area[i] = get_f64(d);
+    s->nodes = get_size(d);
+    s->triangles = get_size(d);
+    s->quads = get_size(d);
+    s->boundary_edges = get_size(d);
+    s->min_angle = get_f64(d);
+    s->max_angle = get_f64(d);
+    s->below_min_angle = get_size(d);
+    s->min_input_angle = get_f64(d);
+    s->quality_min = get_f64(d);
+    s->quality_mean = get_f64(d);
+    get_counts(d, s->quality_histogram, GP_MESH_QUALITY_BINS);
+    s->domain_area = get_f64(d);
+    s->element_area = get_f64(d);
+    s->grain_area = get_f64(d);
+    s->grain_polygon_area = get_f64(d);
+    s->phase_area = get_f64(d);
+    s->phase_polygon_area = get_f64(d);
+    s->band_strips = get_size(d);
+    s->band_thickness_min = get_f64(d);
+    s->band_thickness_mean = get_f64(d);
+    s->refused_refinements = get_size(d);
+    r->has_mesh = !d->failed;
+    return 0;
+}
+
 int gp_section_decode_summary(const char *tag, uint32_t version, const void *data, size_t size,
                               gp_result *summary)
 {
@@ -417,6 +517,8 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
         decode = decode_balance;
     else if (strcmp(tag, GP_SECTION_CELLS) == 0)
         decode = decode_cells;
+    else if (strcmp(tag, GP_SECTION_MESH) == 0)
+        decode = decode_mesh;
     if (!decode)
         return 0;
     if (version != LAYOUT_V1)
@@ -428,6 +530,7 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
     if (d.failed || d.left != 0) {
         summary->has_balance &= strcmp(tag, GP_SECTION_BALANCE) != 0;
         summary->has_cells &= strcmp(tag, GP_SECTION_CELLS) != 0;
+        summary->has_mesh &= strcmp(tag, GP_SECTION_MESH) != 0;
         return GP_EPARSE;
     }
     return 0;
@@ -617,4 +720,62 @@ void gp_sections_source_free(gp_sections_source *s)
     free(s->xy);
     free(s->neighbours);
     free(s);
+}
+
+/* --- the mesh, whole --- */
+
+/* Reads section `tag`, `count` records of `size` bytes, into a new array at *dst. */
+static int read_array(gp_section_read_fn read, void *ctx, const char *tag, size_t count,
+                      size_t size, void **dst)
+{
+    *dst = malloc(count ? count * size : 1);
+    if (!*dst)
+        return GP_ENOMEM;
+    return count ? read(ctx, tag, 0, *dst, count * size) : 0;
+}
+
+int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx)
+{
+    gp_mesh *m = &summary->mesh;
+    if (!summary->has_mesh)
+        return GP_EINVAL;
+    if (m->xy) /* read already */
+        return 0;
+    size_t tri = (size_t)gp_mesh_tri_nodes(m->order), quad = (size_t)gp_mesh_quad_nodes(m->order);
+    void *p[7] = {0};
+    int rc;
+    if ((rc = read_array(read, ctx, GP_SECTION_MESH_XY, 2 * m->nnodes, sizeof(double), &p[0])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_TRI, tri * m->ntri, sizeof(int32_t), &p[1])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_TRI_REGION, m->ntri, sizeof(int32_t), &p[2])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_QUAD, quad * m->nquad, sizeof(int32_t), &p[3])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_QUAD_REGION, m->nquad, sizeof(int32_t), &p[4])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_BEDGE, (size_t)(m->order + 1) * m->nbedges,
+                         sizeof(int32_t), &p[5])) ||
+        (rc = read_array(read, ctx, GP_SECTION_MESH_BEDGE_SIDE, m->nbedges, 1, &p[6])))
+        goto fail;
+    /* a stored node index beyond the nodes, or a region beyond the regions, would make a
+     * writer read out of bounds */
+    const int32_t *idx[5] = {p[1], p[3], p[5], p[2], p[4]};
+    size_t len[5] = {tri * m->ntri, quad * m->nquad, (size_t)(m->order + 1) * m->nbedges, m->ntri,
+                     m->nquad};
+    for (int a = 0; a < 5 && rc == 0; a++)
+        for (size_t i = 0; i < len[a]; i++)
+            if (idx[a][i] < 0 || (size_t)idx[a][i] >= (a < 3 ? m->nnodes : m->ngrains + 1)) {
+                rc = GP_EPARSE;
+                break;
+            }
+    if (rc) {
+    fail:
+        for (int i = 0; i < 7; i++)
+            free(p[i]);
+        return rc;
+    }
+    m->xy = p[0];
+    m->tri = p[1];
+    m->tri_region = p[2];
+    m->quad = p[3];
+    m->quad_region = p[4];
+    m->bedge = p[5];
+    m->bedge_side = p[6];
+    return 0;
 }

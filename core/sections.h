@@ -15,7 +15,16 @@
  *   "cell_xy"         per vertex: x, y (f64 each), cell after cell
  *   "cell_area"       per grain: its cell's area (f64)
  *   "cell_neighbours" per neighbour: its grain id (i32), cell after cell
- * The small sections ("pack", "balance", "cells") make a result's summary: the statistics
+ *   "mesh"            the mesh's summary: kind, order, counts, each region's polygon area,
+ *                     gp_mesh_stats
+ *   "mesh_xy"         per node: x, y (f64 each)
+ *   "mesh_tri"        per triangle: its 3 (order 1) or 6 (order 2) node indices (i32)
+ *   "mesh_tri_region" per triangle: its region (i32)
+ *   "mesh_quad"       per quadrilateral: 4 or 8 node indices (i32)
+ *   "mesh_quad_region" per quadrilateral: its region (i32)
+ *   "mesh_bedge"      per boundary edge: its order + 1 node indices (i32)
+ *   "mesh_bedge_side" per boundary edge: its gp_mesh_side (u8)
+ * The small sections ("pack", "balance", "cells", "mesh") make a result's summary: the statistics
  * and everything a writer needs but the per-grain arrays, which a writer reads window by
  * window through gp_sections_source (below) without holding the whole result.
  *
@@ -44,11 +53,20 @@ extern "C" {
 #define GP_SECTION_CELL_XY "cell_xy"
 #define GP_SECTION_CELL_AREA "cell_area"
 #define GP_SECTION_CELL_NEIGHBOURS "cell_neighbours"
+#define GP_SECTION_MESH "mesh"
+#define GP_SECTION_MESH_XY "mesh_xy"
+#define GP_SECTION_MESH_TRI "mesh_tri"
+#define GP_SECTION_MESH_TRI_REGION "mesh_tri_region"
+#define GP_SECTION_MESH_QUAD "mesh_quad"
+#define GP_SECTION_MESH_QUAD_REGION "mesh_quad_region"
+#define GP_SECTION_MESH_BEDGE "mesh_bedge"
+#define GP_SECTION_MESH_BEDGE_SIDE "mesh_bedge_side"
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24
-/* The most sections a result has today. */
-#define GP_SECTIONS_MAX 16
+/* The most sections a result has today: 9 for the grains, 8 for the mesh, and room for a
+ * few more. */
+#define GP_SECTIONS_MAX 24
 
 typedef struct gp_section {
     char tag[GP_SECTION_TAG_SIZE];
@@ -81,6 +99,12 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
  * (GP_EPARSE when the section is shorter) that stops the writer. */
 typedef int (*gp_section_read_fn)(void *ctx, const char *tag, uint64_t offset, void *dst,
                                   size_t len);
+
+/* Reads the mesh's arrays whole (the mesh formats are not written window by window)
+ * into summary->mesh, whose counts the "mesh" section set; nothing when they are read
+ * already. Returns 0, GP_EINVAL (no mesh), GP_ENOMEM, the reader's error, or GP_EPARSE
+ * when a node index or a region is out of range. What it reads is owned by `summary`. */
+int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx);
 
 /* Grains a window of a stored result holds: the buffers then take about 300 bytes a
  * grain (disks, F, area, a cell's six or so vertices), some 300 KB. */

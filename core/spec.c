@@ -18,7 +18,7 @@
 
 typedef struct validator {
     gp_error *err;
-    size_t max_disks, max_bins;
+    size_t max_disks, max_bins, max_elements;
 } validator;
 
 /* Appends "/" + key (escaped per RFC 6901) to base. */
@@ -424,6 +424,127 @@ static int parse_laguerre(validator *v, const json_t *inputs, const char *base, 
     return get_bool(v, obj, ptr, "flush_boundary", &spec->laguerre.flush_boundary);
 }
 
+/* Reads an optional number in [lower, upper] (lower excluded when `open_lower`). */
+static int get_bounded(validator *v, const json_t *obj, const char *base, const char *key,
+                       double lower, int open_lower, double upper, double *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    if (!value)
+        return 0;
+    const char *open = open_lower ? "(" : "[";
+    if (!json_is_number(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be a number in %s%g, %g], got %s", open,
+                            lower, upper, type_phrase(value));
+    double x = json_number_value(value);
+    if (!isfinite(x) || (open_lower ? !(x > lower) : !(x >= lower)) || !(x <= upper))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be a number in %s%g, %g], got %.17g", open,
+                            lower, upper, x);
+    *out = x;
+    return 0;
+}
+
+/* Reads an optional integer in [lower, upper]. */
+static int get_integer(validator *v, const json_t *obj, const char *base, const char *key,
+                       int lower, int upper, int *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, key);
+    const json_t *value = json_object_get(obj, key);
+    if (!value)
+        return 0;
+    if (!json_is_integer(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an integer from %d to %d, got %s", lower,
+                            upper, type_phrase(value));
+    json_int_t n = json_integer_value(value);
+    if (n < lower || n > upper)
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be an integer from %d to %d, got %lld", lower,
+                            upper, (long long)n);
+    *out = (int)n;
+    return 0;
+}
+
+/* "min_angle": refused above what Delaunay refinement is proved to reach. */
+static int get_min_angle(validator *v, const json_t *obj, const char *base, double *out)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, "min_angle");
+    const json_t *value = json_object_get(obj, "min_angle");
+    if (value && json_is_number(value) && json_number_value(value) > GP_MESH_MAX_MIN_ANGLE)
+        return gp_error_set(v->err, GP_EINVAL, ptr,
+                            "must be <= %g degrees, got %.17g: CGAL's Delaunay refinement is "
+                            "guaranteed to end only for a minimum angle up to arcsin(sqrt(1/8))",
+                            GP_MESH_MAX_MIN_ANGLE, json_number_value(value));
+    return get_bounded(v, obj, base, "min_angle", 0.0, 0, GP_MESH_MAX_MIN_ANGLE, out);
+}
+
+/* The largest element size a spec may ask for: no grain is larger than the domain. */
+#define SPEC_MAX_ELEMENT_SIZE 1e300
+
+static int parse_abaqus(validator *v, const json_t *mesh, const char *base, gp_mesh_params *m)
+{
+    char ptr[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, mesh, base, "abaqus", 0, &obj, ptr);
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"plane", "reduced_integration", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "plane, reduced_integration")))
+        return rc;
+    if (json_object_get(obj, "plane")) {
+        static const char *const planes[] = {"stress", "strain", NULL};
+        int plane;
+        if ((rc = get_choice(v, obj, ptr, "plane", planes, "stress, strain", &plane)))
+            return rc;
+        m->plane = (gp_mesh_plane)plane;
+    }
+    return get_bool(v, obj, ptr, "reduced_integration", &m->reduced);
+}
+
+static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+{
+    char ptr[GP_ERROR_POINTER_MAX], member[GP_ERROR_POINTER_MAX];
+    const json_t *obj;
+    int rc = get_object(v, inputs, base, "mesh", 0, &obj, ptr);
+    if (rc || !obj)
+        return rc;
+    static const char *const members[] = {"element_size", "min_angle", "order", "band_layers",
+                                          "band_size", "disk_tolerance", "abaqus", NULL};
+    if ((rc = check_members(v, obj, ptr, members,
+                            "element_size, min_angle, order, band_layers, band_size, "
+                            "disk_tolerance, abaqus")))
+        return rc;
+    gp_mesh_params *m = &spec->mesh;
+    spec->mesh_enabled = 1;
+    gp_mesh_params_default(&spec->dist, m);
+    if ((rc = get_bounded(v, obj, ptr, "element_size", 0.0, 1, SPEC_MAX_ELEMENT_SIZE, &m->element_size)) ||
+        (rc = get_min_angle(v, obj, ptr, &m->min_angle)) ||
+        (rc = get_integer(v, obj, ptr, "order", 1, 2, &m->order)) ||
+        (rc = get_integer(v, obj, ptr, "band_layers", 0, GP_MESH_MAX_BAND_LAYERS, &m->band_layers)) ||
+        (rc = get_bounded(v, obj, ptr, "band_size", 0.0, 1, SPEC_MAX_ELEMENT_SIZE, &m->band_size)) ||
+        (rc = get_bounded(v, obj, ptr, "disk_tolerance", 0.0, 1, 0.25, &m->disk_tolerance)) ||
+        (rc = parse_abaqus(v, obj, ptr, m)))
+        return rc;
+    if (m->band_layers > 0 && (!spec->laguerre_enabled || spec->laguerre.shrink != GP_SHRINK_OFFSET)) {
+        pointer_key(member, ptr, "band_layers");
+        return gp_error_set(v->err, GP_EINVAL, member,
+                            "needs \"laguerre\": {\"shrink\": \"offset\"} (the band's strips have "
+                            "parallel sides only between offset cells)");
+    }
+    if (json_object_get(obj, "band_size") && m->band_layers == 0) {
+        pointer_key(member, ptr, "band_size");
+        return gp_error_set(v->err, GP_EINVAL, member, "is the length of the band's quadrilaterals: "
+                                                       "it needs band_layers >= 1");
+    }
+    if (json_object_get(obj, "disk_tolerance") && spec->laguerre_enabled) {
+        pointer_key(member, ptr, "disk_tolerance");
+        return gp_error_set(v->err, GP_EINVAL, member, "polygonises disks in a matrix: it has no "
+                                                       "meaning with Laguerre cells");
+    }
+    return 0;
+}
+
 static int parse_picture(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
 {
     char ptr[GP_ERROR_POINTER_MAX], color_ptr[GP_ERROR_POINTER_MAX];
@@ -581,6 +702,20 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
                             "about %.3g disks expected and up to %.3g possible, more than the limit "
                             "of %zu; use a smaller domain or larger grains",
                             spec->expected_disks, bound, v->max_disks);
+    spec->max_elements = v->max_elements;
+    if (!spec->mesh_enabled)
+        return 0;
+    char size_ptr[GP_ERROR_POINTER_MAX], mesh_ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(mesh_ptr, base, "mesh");
+    pointer_key(size_ptr, mesh_ptr, "element_size");
+    spec->expected_elements = gp_mesh_expected_elements(
+        &spec->domain, &spec->dist, &spec->joint, spec->expected_disks, spec->laguerre_enabled,
+        spec->laguerre.shrink, &spec->mesh);
+    if (!(spec->expected_elements <= (double)v->max_elements))
+        return gp_error_set(v->err, GP_ETOOBIG, size_ptr,
+                            "about %.3g elements expected (element size %g), more than the limit "
+                            "of %zu; ask for larger elements or a smaller domain",
+                            spec->expected_elements, spec->mesh.element_size, v->max_elements);
     return 0;
 }
 
@@ -606,16 +741,18 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         base = "/inputs";
     }
     static const char *const members[] = {"domain", "distribution", "joint", "seed", "front",
-                                          "balance", "laguerre", "picture", NULL};
+                                          "balance", "laguerre", "mesh", "picture", NULL};
     int rc;
     if ((rc = check_members(v, inputs, base, members,
-                            "domain, distribution, joint, seed, front, balance, laguerre, picture")) ||
+                            "domain, distribution, joint, seed, front, balance, laguerre, mesh, "
+                            "picture")) ||
         (rc = parse_domain(v, inputs, base, &spec->domain)) ||
         (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = parse_seed(v, inputs, base, &spec->seed)) ||
         (rc = parse_front(v, inputs, base, &spec->level_band, &spec->level_band_set)) ||
         (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
+        (rc = parse_mesh(v, inputs, base, spec)) ||
         (rc = parse_picture(v, inputs, base, spec)) || (rc = check_whole(v, base, spec)))
         return rc;
     if (gp_distribution_prepare(&spec->dist))
@@ -627,11 +764,14 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
                   gp_error *err)
 {
     memset(spec, 0, sizeof *spec);
-    validator v = {err, GP_SPEC_DEFAULT_MAX_DISKS, GP_SPEC_DEFAULT_MAX_BINS};
+    validator v = {err, GP_SPEC_DEFAULT_MAX_DISKS, GP_SPEC_DEFAULT_MAX_BINS,
+                   GP_SPEC_DEFAULT_MAX_ELEMENTS};
     if (limits && limits->max_disks)
         v.max_disks = limits->max_disks;
     if (limits && limits->max_bins)
         v.max_bins = limits->max_bins;
+    if (limits && limits->max_elements)
+        v.max_elements = limits->max_elements;
     /* jansson reads a NUL byte between tokens as if it were white space; JSON has none */
     const char *nul = memchr(text, '\0', len);
     if (nul)

@@ -53,6 +53,26 @@ static json_t *joint_json(const gp_joint *j, int *failed)
     return o;
 }
 
+/* The "mesh" object: band_size only with band layers and disk_tolerance only without
+ * cells, as the parser refuses them elsewhere (the result must parse again). */
+static json_t *mesh_json(const gp_spec *spec, int *failed)
+{
+    const gp_mesh_params *m = &spec->mesh;
+    json_t *o = json_object();
+    put(o, "element_size", json_real(m->element_size), failed);
+    put(o, "min_angle", json_real(m->min_angle), failed);
+    put(o, "order", json_integer(m->order), failed);
+    put(o, "band_layers", json_integer(m->band_layers), failed);
+    if (m->band_layers > 0 && m->band_size > 0.0)
+        put(o, "band_size", json_real(m->band_size), failed);
+    if (!spec->laguerre_enabled)
+        put(o, "disk_tolerance", json_real(m->disk_tolerance), failed);
+    put(o, "abaqus", json_pack("{s:s, s:b}", "plane",
+                               m->plane == GP_MESH_PLANE_STRAIN ? "strain" : "stress",
+                               "reduced_integration", m->reduced), failed);
+    return o;
+}
+
 json_t *gp_spec_json(const gp_spec *spec)
 {
     int failed = 0;
@@ -74,6 +94,8 @@ json_t *gp_spec_json(const gp_spec *spec)
     if (spec->laguerre_enabled)
         put(in, "laguerre", json_pack("{s:s, s:b}", "shrink", gp_shrink_name(spec->laguerre.shrink),
                                       "flush_boundary", spec->laguerre.flush_boundary), &failed);
+    if (spec->mesh_enabled)
+        put(in, "mesh", mesh_json(spec, &failed), &failed);
     put(in, "picture", json_pack("{s:s, s:b}", "color",
                                  spec->picture_color == GP_PICTURE_COLOR_QUALITY ? "quality" : "radius",
                                  "disks", spec->picture_disks), &failed);

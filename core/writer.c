@@ -69,6 +69,9 @@ gp_writer *gp_writer_new(gp_format format, const gp_spec *spec, const gp_result 
     case GP_FORMAT_CSV: rc = gp_plan_csv(w); break;
     case GP_FORMAT_SVG: rc = gp_plan_svg(w); break;
     case GP_FORMAT_VTK: rc = gp_plan_vtk(w); break;
+    case GP_FORMAT_MSH:
+    case GP_FORMAT_INP:
+    case GP_FORMAT_VTU: rc = gp_plan_mesh(w); break;
     }
     if (rc || w->overflow) {
         gp_writer_free(w);

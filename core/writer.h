@@ -45,5 +45,7 @@ int gp_plan_csv(gp_writer *w);
 int gp_plan_json(gp_writer *w);
 int gp_plan_svg(gp_writer *w);
 int gp_plan_vtk(gp_writer *w);
+/* msh, inp and vtu: the whole file in one text step, from the result's mesh (io_mesh_plan.c). */
+int gp_plan_mesh(gp_writer *w);
 
 #endif

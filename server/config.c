@@ -17,6 +17,9 @@
 #define DEFAULT_MAX_WAIT 60
 /* The engine's own cap on histogram bins (a histogram is sampled by a table this long). */
 #define DEFAULT_MAX_BINS ((size_t)10000)
+/* A mesh of 2 million elements weighs about 300 MB while it is built and 100 MB as a .msh
+ * file (bench/MESH.md): a tenth of the library's default, like the disks. */
+#define DEFAULT_MAX_ELEMENTS ((size_t)2000000)
 /* A job at the default disk cap packs in seconds; ten minutes leaves room for slow
  * stages and a loaded machine, and still frees a worker held by a runaway job. */
 #define DEFAULT_MAX_JOB_SECONDS 600.0
@@ -72,6 +75,9 @@ static const option options[] = {
      SIZE(max_disks, 1, (size_t)1 << 40)},
     {"--max-bins", "GRAINPACKD_MAX_BINS", "most histogram bins in a spec (default 10000)",
      SIZE(max_bins, 1, (size_t)1 << 24)},
+    {"--max-elements", "GRAINPACKD_MAX_ELEMENTS",
+     "largest mesh in expected elements; a mesh growing beyond fails (default 2000000)",
+     SIZE(max_elements, 1, (size_t)1 << 40)},
     {"--max-job-seconds", "GRAINPACKD_MAX_JOB_SECONDS",
      "seconds a job may run before it is stopped and failed (default 600; 0: no limit)",
      SECONDS(max_job_seconds, 0, 10000000)},
@@ -185,6 +191,7 @@ int gp_config_load(gp_config *cfg, int argc, char **argv, FILE *out, FILE *err)
     cfg->max_queued = DEFAULT_MAX_QUEUED;
     cfg->max_disks = DEFAULT_MAX_DISKS;
     cfg->max_bins = DEFAULT_MAX_BINS;
+    cfg->max_elements = DEFAULT_MAX_ELEMENTS;
     cfg->max_job_seconds = DEFAULT_MAX_JOB_SECONDS;
     cfg->max_job_attempts = DEFAULT_MAX_JOB_ATTEMPTS;
     cfg->max_jobs_per_key = DEFAULT_MAX_JOBS_PER_KEY;

@@ -18,6 +18,7 @@ typedef struct gp_config {
     size_t max_queued;        /* --max-queued / GRAINPACKD_MAX_QUEUED, default 10000 */
     size_t max_disks;         /* --max-disks / GRAINPACKD_MAX_DISKS, default 2000000 */
     size_t max_bins;          /* --max-bins / GRAINPACKD_MAX_BINS histogram bins, default 10000 */
+    size_t max_elements;      /* --max-elements / GRAINPACKD_MAX_ELEMENTS of a mesh, default 2000000 */
     double max_job_seconds;   /* --max-job-seconds / GRAINPACKD_MAX_JOB_SECONDS of running per
                                  job, default 600; 0: no limit */
     int max_job_attempts;     /* --max-job-attempts / GRAINPACKD_MAX_JOB_ATTEMPTS: times a job is

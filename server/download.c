@@ -28,6 +28,8 @@ typedef struct gp_download {
     gp_format format;
     gp_result_reader *reader;
     gp_sections_source *source;
+    gp_sections_source *whole; /* VTU's grains, read in one window (io_mesh_plan.c) */
+    int loaded;                /* what the mesh formats read whole is in res.summary */
     gp_writer *writer;
     gp_out text;       /* rendered; bytes from `sent` on not handed on yet */
     size_t sent;
@@ -43,6 +45,40 @@ static int read_section(void *ctx, const char *tag, uint64_t offset, void *dst, 
     return d->db ? gp_result_reader_read(d->reader, d->db, tag, offset, dst, len) : GP_SRV_EDB;
 }
 
+/* The mesh formats read the result whole, not window by window: the mesh's arrays
+ * (msh, inp, vtu, and svg which draws the edges) and, for vtu, the grains' arrays, lent
+ * to the summary from one window over all grains (taken back in release). Returns 0 or
+ * the reader's error. */
+static int load_whole(gp_download *d)
+{
+    gp_result *r = &d->res.summary;
+    int rc = 0;
+    if (r->has_mesh && (d->format == GP_FORMAT_MSH || d->format == GP_FORMAT_INP ||
+                        d->format == GP_FORMAT_VTU || d->format == GP_FORMAT_SVG))
+        rc = gp_sections_read_mesh(r, read_section, d);
+    if (rc == 0 && d->format == GP_FORMAT_VTU && r->packing.count > 0) {
+        if (!(d->whole = gp_sections_source_new(r, read_section, d, r->packing.count)))
+            return GP_ENOMEM;
+        unsigned needs = GP_GRAINS_DISKS | (r->has_balance ? GP_GRAINS_F : 0) |
+                         (r->has_cells ? GP_GRAINS_AREA | GP_GRAINS_POLYGONS | GP_GRAINS_NEIGHBOURS : 0);
+        gp_grain_source g = gp_sections_source_grains(d->whole);
+        gp_grain_window win;
+        if ((rc = g.load(g.ctx, needs, 0, &win)))
+            return rc;
+        r->packing.disks = (gp_disk *)win.disks;
+        if (r->has_balance)
+            r->balance.F = (double *)win.F;
+        if (r->has_cells) {
+            r->cells.area = (double *)win.area;
+            r->cells.start = (size_t *)win.start;
+            r->cells.xy = (double *)win.xy;
+            r->cells.nstart = (size_t *)win.nstart;
+            r->cells.neighbours = (int32_t *)win.neighbours;
+        }
+    }
+    return rc;
+}
+
 /* Renders on until `text` holds `want` bytes or the writer is done. Returns 0 or the
  * writer's error (logged). */
 static int render(gp_download *d, size_t want)
@@ -53,7 +89,13 @@ static int render(gp_download *d, size_t want)
         gp_log("download: no store connection: the download is cut short");
         return GP_SRV_EDB;
     }
-    int rc = gp_writer_run(d->writer, &d->text, want);
+    int rc = 0;
+    if (!d->loaded) {
+        rc = load_whole(d);
+        d->loaded = rc == 0;
+    }
+    if (rc == 0)
+        rc = gp_writer_run(d->writer, &d->text, want);
     if (rc < 0) {
         gp_log("download: rendering %s of a stored result failed (%d): the download is cut short",
                gp_format_name(d->format), rc);
@@ -128,6 +170,15 @@ static void release(gp_body_stream *s)
         deflateEnd(&d->z);
     gp_writer_free(d->writer);
     gp_sections_source_free(d->source);
+    if (d->whole) { /* the grains lent to the summary are the window's */
+        gp_result *r = &d->res.summary;
+        r->packing.disks = NULL;
+        r->balance.F = NULL;
+        r->cells.area = r->cells.xy = NULL;
+        r->cells.start = r->cells.nstart = NULL;
+        r->cells.neighbours = NULL;
+    }
+    gp_sections_source_free(d->whole);
     gp_result_reader_free(d->reader);
     gp_out_free(&d->text);
     gp_stored_result_free(&d->res);

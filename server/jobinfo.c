@@ -31,7 +31,7 @@ json_t *gp_job_status_info(const gp_job *job)
          * knowing them: a format the engine gains appears here by itself */
         for (size_t i = 0; i < gp_format_count(); i++) {
             gp_format f = (gp_format)i;
-            if (f == GP_FORMAT_JSON)
+            if (f == GP_FORMAT_JSON || (gp_format_needs_mesh(f) && !job->has_mesh))
                 continue;
             char href[96], title[48];
             snprintf(href, sizeof href, "%s?f=%s", results, gp_format_name(f));

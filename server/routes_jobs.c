@@ -43,7 +43,8 @@ static int query_count(const gp_request *req, const char *name, long long lo, lo
  * caller frees it), or -1 with the 400/422 problem in reply. */
 static int parse_spec(gp_request *req, gp_spec *spec, gp_reply *reply)
 {
-    gp_spec_limits limits = {req->svc->cfg->max_disks, req->svc->cfg->max_bins};
+    gp_spec_limits limits = {req->svc->cfg->max_disks, req->svc->cfg->max_bins,
+                             req->svc->cfg->max_elements};
     gp_error err;
     gp_error_clear(&err);
     if (gp_spec_parse(req->body, req->body_len, &limits, spec, &err)) {
@@ -64,10 +65,11 @@ int gp_route_validate(gp_request *req, gp_reply *reply)
     if (parse_spec(req, &spec, reply))
         return GP_ROUTE_DONE;
     /* nothing is stored or queued: the answer is what a submission would be accepted as */
-    json_t *body = json_pack("{s:b, s:I, s:o*, s:{s:I, s:I}}", "valid", 1, "expected_disks",
+    json_t *body = json_pack("{s:b, s:I, s:o*, s:{s:I, s:I, s:I}}", "valid", 1, "expected_disks",
                              (json_int_t)llround(spec.expected_disks), "inputs", gp_spec_json(&spec),
                              "limits", "max_disks", (json_int_t)svc->cfg->max_disks, "max_bins",
-                             (json_int_t)svc->cfg->max_bins);
+                             (json_int_t)svc->cfg->max_bins, "max_elements",
+                             (json_int_t)svc->cfg->max_elements);
     gp_spec_free(&spec);
     if (!body || !json_object_get(body, "inputs")) {
         json_decref(body);

@@ -59,7 +59,7 @@ static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp
         return 1;
     gp_error err;
     /* accepted once, so parsed without today's caps */
-    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
     if (rc == 0 && (rc = gp_spec_parse(res->spec_text, res->spec_len, &unlimited, spec, &err)))
         gp_stored_result_free(res);
     if (rc == GP_ENOMEM) {
@@ -106,6 +106,14 @@ int gp_route_results(gp_request *req, gp_reply *reply)
         gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
                    "color=quality colours the grains by F, which only a job that balances has; "
                    "job %s has no balance stage (color=radius)", req->id);
+        gp_stored_result_free(&res);
+        gp_spec_free(&spec);
+        return GP_ROUTE_DONE;
+    }
+    if (gp_format_needs_mesh(format) && !res.summary.has_mesh) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "f=%s is the job's finite-element mesh; job %s has none (its spec has no "
+                   "\"mesh\"): json, csv, svg, vtk or vtu", gp_format_name(format), req->id);
         gp_stored_result_free(&res);
         gp_spec_free(&spec);
         return GP_ROUTE_DONE;

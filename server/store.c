@@ -20,7 +20,10 @@
 /* Bytes the WAL file is cut back to after a checkpoint (see PRAGMA journal_size_limit). */
 #define WAL_SIZE_LIMIT (64 << 20)
 
-#define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message"
+/* has_mesh: the spec asks for a mesh ("mesh" in the inputs, wrapped or bare: a bare spec
+ * cannot hold "inputs"), so that a job lists the mesh formats only when it has them */
+#define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message," \
+                    " coalesce(json_type(spec, '$.inputs.mesh'), json_type(spec, '$.mesh')) IS NOT NULL"
 
 static const char *const stmt_sql[ST_COUNT_OF] = {
     [ST_INSERT] = "INSERT INTO jobs (id, status, created, updated, message, spec, domain_width,"

@@ -59,6 +59,7 @@ typedef struct gp_job {
     char created[32], started[32], finished[32], updated[32];
     int progress; /* 0-100 */
     char message[256];
+    int has_mesh; /* the spec asks for a mesh: the job's results include msh and inp */
 } gp_job;
 
 typedef struct gp_store gp_store;

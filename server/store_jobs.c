@@ -68,6 +68,7 @@ static void read_job(sqlite3_stmt *s, gp_job *job)
     gp_db_copy_text(job->updated, sizeof job->updated, s, 6);
     job->progress = sqlite3_column_int(s, 7);
     gp_db_copy_text(job->message, sizeof job->message, s, 8);
+    job->has_mesh = sqlite3_column_int(s, 9);
 }
 
 /* The owner's accepted and running jobs; inside the inserting transaction. */
@@ -120,6 +121,7 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
     sqlite3_bind_int64(s, 9, (sqlite3_int64)spec->seed);
     sqlite3_bind_double(s, 10, spec->expected_disks);
     sqlite3_bind_text(s, 11, owner, -1, SQLITE_STATIC);
+    out->has_mesh = spec->mesh_enabled;
     if (sqlite3_step(s) == SQLITE_ROW)
         out->seq = sqlite3_column_int64(s, 0);
     else

@@ -63,7 +63,7 @@ static int load_v2(gp_db *db, const char *id, gp_spec *spec, gp_result *result, 
     int rc = sqlite3_step(s) == SQLITE_ROW ? 0 : GP_SRV_EDB;
     gp_packing *p = &result->packing;
     if (rc == 0) {
-        gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+        gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
         gp_error err;
         size_t count = (size_t)sqlite3_column_int64(s, 1);
         size_t bytes = (size_t)sqlite3_column_bytes(s, 2);

@@ -491,7 +491,7 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
 
     /* the stored spec was valid when accepted; it is parsed again without the caps, which
      * may have been lowered since, so that an accepted job always runs */
-    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
     gp_spec spec;
     gp_result result;
     gp_error err;
@@ -501,6 +501,9 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     if (rc == 0) {
         test_stall(w, id);
         plan_stages(w, &spec);
+        /* a mesh stops when it grows far beyond today's cap (the estimate it was accepted
+           on may be off; gp_spec.max_elements) */
+        spec.max_elements = svc->cfg->max_elements;
         gp_progress progress = {report_progress, w, &w->cancel};
         gp_metrics_pipeline_run(svc->metrics);
         rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);

@@ -71,7 +71,7 @@ grep -q "more than the limit of 1000" "$tmp/err" || fail "cap message: $(cat "$t
 
 # usage errors: exit 2
 "$bin" run "$examples/iron.json" --format xml 2> "$tmp/err"; [ $? -eq 2 ] || fail "unknown format"
-grep -q "expected json, csv, svg or vtk" "$tmp/err" || fail "unknown format message: $(cat "$tmp/err")"
+grep -q "expected json, csv, svg, vtk, vtu, msh or inp" "$tmp/err" || fail "unknown format message: $(cat "$tmp/err")"
 "$bin" frobnicate 2> /dev/null; [ $? -eq 2 ] || fail "unknown command"
 "$bin" run 2> /dev/null; [ $? -eq 2 ] || fail "missing spec"
 "$bin" run "$examples/iron.json" --max-disks -5 2> /dev/null; [ $? -eq 2 ] || fail "negative cap"

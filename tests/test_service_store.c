@@ -161,6 +161,11 @@ static void check_formats(gp_db *db, const char *id, const gp_spec *spec, const 
     CHECK(res.summary.packing.count == expected->packing.count);
     CHECK(res.summary.has_balance == expected->has_balance && res.summary.has_cells == expected->has_cells);
     for (size_t f = 0; f < gp_format_count(); f++) {
+        /* msh and inp exist only with a mesh (these jobs have none); vtu reads the grains
+         * whole, which only the service's download lends it (test_service_downloads
+         * compares its bytes over HTTP) */
+        if ((gp_format_needs_mesh((gp_format)f) && !expected->has_mesh) || f == GP_FORMAT_VTU)
+            continue;
         size_t a, b;
         char *want = render_memory(spec, expected, (gp_format)f, &a);
         char *got = render_stored(db, &res, spec, (gp_format)f, &b);

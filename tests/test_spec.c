@@ -310,7 +310,13 @@ static int same_spec(const gp_spec *a, const gp_spec *b)
                a->laguerre_enabled == b->laguerre_enabled &&
                a->laguerre.shrink == b->laguerre.shrink &&
                a->laguerre.flush_boundary == b->laguerre.flush_boundary &&
-               a->picture_color == b->picture_color && a->picture_disks == b->picture_disks;
+               a->picture_color == b->picture_color && a->picture_disks == b->picture_disks &&
+               a->mesh_enabled == b->mesh_enabled && a->expected_elements == b->expected_elements &&
+               a->mesh.element_size == b->mesh.element_size &&
+               a->mesh.min_angle == b->mesh.min_angle && a->mesh.order == b->mesh.order &&
+               a->mesh.band_layers == b->mesh.band_layers && a->mesh.band_size == b->mesh.band_size &&
+               a->mesh.disk_tolerance == b->mesh.disk_tolerance && a->mesh.plane == b->mesh.plane &&
+               a->mesh.reduced == b->mesh.reduced;
     for (size_t i = 0; same && i < a->dist.nbins; i++)
         same = a->dist.bins[i].min == b->dist.bins[i].min &&
                a->dist.bins[i].max == b->dist.bins[i].max && a->dist.bins[i].p == b->dist.bins[i].p;
@@ -334,6 +340,12 @@ static void test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit(vo
         "\"disks\":true}}",
         "{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\"},\"laguerre\":{\"shrink\":"
         "\"homothetic\"}}",
+        /* the mesh: defaults, then every option, then disks in a matrix */
+        "{" DOM "," CONST ",\"laguerre\":{\"shrink\":\"offset\"},\"mesh\":{}}",
+        "{" DOM "," CONST ",\"laguerre\":{\"shrink\":\"offset\"},\"mesh\":{\"element_size\":0.3,"
+        "\"min_angle\":15,\"order\":2,\"band_layers\":3,\"band_size\":0.05,\"abaqus\":"
+        "{\"plane\":\"strain\",\"reduced_integration\":true}}}",
+        "{" DOM "," CONST ",\"mesh\":{\"disk_tolerance\":0.01}}",
     };
     for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++) {
         gp_spec a, b;
@@ -356,6 +368,10 @@ static void test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit(vo
         CHECK((json_object_get(json_object_get(first, "front"), "level_band") != NULL) == a.level_band_set);
         CHECK(json_object_get(json_object_get(first, "picture"), "color") != NULL);
         CHECK((json_object_get(first, "balance") != NULL) == a.balance_enabled);
+        CHECK((json_object_get(first, "mesh") != NULL) == a.mesh_enabled);
+        if (a.mesh_enabled)
+            CHECK(json_real_value(json_object_get(json_object_get(first, "mesh"), "element_size")) ==
+                  a.mesh.element_size);
         if (a.balance_enabled)
             CHECK(json_integer_value(json_object_get(json_object_get(first, "balance"),
                                                      "max_iterations")) == a.balance.max_iterations);

@@ -26,10 +26,14 @@ typedef enum gp_format {
     GP_FORMAT_JSON = 0,
     GP_FORMAT_CSV,
     GP_FORMAT_SVG,
-    GP_FORMAT_VTK
+    GP_FORMAT_VTK,
+    GP_FORMAT_MSH, /* the mesh: Gmsh MSH 4.1 (io_mesh.h) */
+    GP_FORMAT_INP, /* the mesh: Abaqus input */
+    GP_FORMAT_VTU  /* the mesh, or the grains without one: VTK XML unstructured grid */
 } gp_format;
 
-/* Maps "json", "csv", "svg" or "vtk" to a format; returns 0 or GP_EINVAL. */
+/* Maps "json", "csv", "svg", "vtk", "msh", "inp" or "vtu" to a format; returns 0 or
+ * GP_EINVAL. */
 GP_API int gp_format_parse(const char *name, gp_format *out);
 GP_API const char *gp_format_name(gp_format format);
 /* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,
@@ -106,6 +110,9 @@ GP_API void gp_writer_free(gp_writer *w);
  * GP_ENOMEM or the sink's error (GP_EIO for a file). */
 GP_API int gp_write_result(gp_out *out, gp_format format, const gp_spec *spec,
                            const gp_result *result);
+
+/* Whether the format exists only for jobs with a mesh (msh, inp). */
+GP_API int gp_format_needs_mesh(gp_format format);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,7 @@
 #include "grainpack/balance.h"
 #include "grainpack/error.h"
 #include "grainpack/laguerre.h"
+#include "grainpack/mesh.h"
 #include "grainpack/pack.h"
 #include "grainpack/progress.h"
 #include "grainpack/spec.h"
@@ -21,7 +22,8 @@ extern "C" {
 
 /* Wall-clock time spent in one stage. */
 typedef struct gp_stage_time {
-    const char *stage; /* static string: "pack", "triangulation", "balance", "laguerre", "stats" */
+    const char *stage; /* static string: "pack", "triangulation", "balance", "laguerre", "mesh",
+                          "stats" */
     double seconds;
 } gp_stage_time;
 
@@ -33,6 +35,8 @@ typedef struct gp_result {
     int has_cells;        /* the Laguerre stage ran: `cells` and `cell_stats` are set */
     gp_cells cells;       /* owned */
     gp_cell_stats cell_stats; /* owned */
+    int has_mesh;         /* the mesh stage ran: `mesh` is set */
+    gp_mesh mesh;         /* owned */
     gp_stage_time timings[GP_MAX_STAGES];
     int ntimings;
 } gp_result;
@@ -45,7 +49,8 @@ GP_API int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progr
 
 /* Rebuilds, from the final disks in result->packing (what a store keeps) and the spec,
  * what the stages after packing derived from them: F and its statistics when the spec
- * balances, the Laguerre cells and their statistics when it builds cells. The same disks
+ * balances, the Laguerre cells and their statistics when it builds cells, the mesh when
+ * it meshes. The same disks
  * give the same bytes as the run did. What only the run saw (F before balancing, the
  * sweeps) is not rebuilt: result->balance.after_only is set and the writers leave it
  * out. Returns 0 or the stage's error code with err filled (result then keeps only

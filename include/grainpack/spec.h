@@ -13,6 +13,7 @@
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
 #include "grainpack/laguerre.h"
+#include "grainpack/mesh.h"
 #include "grainpack/pack.h"
 
 #ifdef __cplusplus
@@ -23,10 +24,13 @@ extern "C" {
 typedef struct gp_spec_limits {
     size_t max_disks; /* reject specs expected to pack more disks than this */
     size_t max_bins;  /* reject histograms with more bins than this */
+    size_t max_elements; /* reject meshes expected to have more elements than this */
 } gp_spec_limits;
 
 #define GP_SPEC_DEFAULT_MAX_DISKS ((size_t)20000000)
 #define GP_SPEC_DEFAULT_MAX_BINS ((size_t)10000)
+/* About 3 GB of mesh at the stage's ~150 bytes an element (bench/MESH.md). */
+#define GP_SPEC_DEFAULT_MAX_ELEMENTS ((size_t)20000000)
 #define GP_SPEC_DEFAULT_SEED 1
 /* The widest level band a spec may ask for: beyond a few levels the fill stops being
  * layered and density no longer improves (see bench/). */
@@ -59,6 +63,13 @@ typedef struct gp_spec {
     gp_laguerre_params laguerre; /* "laguerre": {"shrink", "flush_boundary"} */
     gp_picture_color picture_color; /* "picture": {"color"}: quality when balancing, else radius */
     int picture_disks;     /* "picture": {"disks"}: outline the grain disks over the cells */
+    int mesh_enabled;      /* the spec has "mesh" */
+    gp_mesh_params mesh;   /* "mesh": {"element_size", "min_angle", "order", "band_layers",
+                              "band_size", "disk_tolerance", "abaqus": {"plane", "reduced"}} */
+    double expected_elements; /* the mesh's estimate used against the cap (0 without mesh) */
+    size_t max_elements;   /* the cap the spec was checked against: the mesh stage fails
+                              when the mesh grows beyond GP_MESH_CAP_SLACK times it (the
+                              estimate is good to a factor of about two) */
 } gp_spec;
 
 /* Parses and validates a job spec: either the whole execute request {"inputs": {...}}

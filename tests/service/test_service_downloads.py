@@ -29,7 +29,7 @@ import time
 
 import gpd
 
-FORMATS = ("json", "csv", "svg", "vtk")
+FORMATS = ("json", "csv", "svg", "vtk", "vtu")
 # The job: the Bagi law on 56 x 56 (about 11 600 grains), two sweeps of relocation,
 # offset cells, coloured by F: every section a result can have.
 SPEC = {"inputs": {"domain": {"width": 56, "height": 56},

@@ -30,7 +30,7 @@ def check_service_documents(c, api, client):
     c.check([p["id"] for p in processes] == ["pack2d"], f"processes {processes}")
     desc = client.get("/processes/pack2d").json()
     c.check(set(desc["inputs"]) == {"domain", "distribution", "joint", "front", "seed", "balance",
-                                    "laguerre", "picture"},
+                                    "laguerre", "mesh", "picture"},
             f"process inputs {list(desc['inputs'])}")
     served = client.get("/openapi.yaml")
     api.check(c, "GET", "/openapi.yaml", served)

@@ -39,11 +39,16 @@ def test(c, binary):
             saved = [f for f in os.listdir(work) if re.fullmatch(r"job-[0-9a-f-]{36}\.csv", f)]
             c.check(len(saved) == 1 and open(os.path.join(work, saved[0])).read().startswith("x,y,r,R\n"),
                     f"the download was not saved as job-<id>.csv (decompressed): {os.listdir(work)}")
+            for name, last in (("iron_mesh.msh", "$EndElements"), ("iron_mesh.inp", "*Nset, nset=top"),
+                               ("iron_mesh.vtu", "</VTKFile>")):
+                path = os.path.join(work, name)
+                text = open(path).read() if os.path.exists(path) else ""
+                c.check(last in text, f"{name} downloaded by the walk-through is not a whole file")
         for expected in ['"conformsTo"', '"id":"pack2d"', "job at http://", '"status":"successful"',
                          "<!doctype html>", '"valid":true,"expected_disks":',
                          "x,y,r,R", '"packing_density"', '"timings"', "\n304\n", '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
-                         'grainpack_jobs{status="successful"}', "openapi: 3.1.0"]:
+                         'grainpack_jobs{status="successful"}', "openapi: 3.1.0", "$MeshFormat\n4.1 0 8"]:
             c.check(expected in out, f"walk-through output lacks {expected!r}")
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:

@@ -130,6 +130,7 @@ def full_spec():
     spec = gpd.load_example("iron")
     spec["inputs"].update({"front": {"level_band": 1}, "balance": {"method": "relocation", "max_iterations": 30},
                            "laguerre": {"shrink": "offset"}, "picture": {"color": "radius", "disks": True},
+                           "mesh": {"element_size": 4, "band_layers": 1},
                            "seed": 7})
     return spec
 
@@ -146,6 +147,8 @@ def check_validation(c, api, client, daemon):
     c.check(set(spec["inputs"]) <= set(inputs), f"normalised inputs lost {set(spec['inputs']) - set(inputs)}")
     c.check(inputs["balance"] == {"method": "relocation", "max_iterations": 30, "max_step": 1.0}, f"balance {inputs['balance']}")
     c.check(inputs["laguerre"] == {"shrink": "offset", "flush_boundary": False}, f"laguerre {inputs['laguerre']}")
+    c.check(inputs["mesh"] == {"element_size": 4, "min_angle": 20.7048, "order": 1, "band_layers": 1,
+                               "abaqus": {"plane": "stress", "reduced_integration": False}}, f"mesh {inputs['mesh']}")
     c.check(inputs["distribution"] == spec["inputs"]["distribution"], "the bins are not given back as sent")
     c.check(answer["limits"]["max_disks"] == 2000000 and answer["limits"]["max_bins"] == 10000, f"limits {answer['limits']}")
     # the defaults written out, and the normalised spec a fixed point of validation
@@ -208,7 +211,8 @@ def check_results(c, api, client):
         results = [link for link in info["links"] if link["rel"] == "http://www.opengis.net/def/rel/ogc/1.0/results"]
         formats = {re.search(r"[?&]f=(\w+)", link["href"]).group(1) if "f=" in link["href"] else "json"
                    for link in results}
-        c.check(formats == {"json", "csv", "svg", "vtk"}, f"{name}: result links for {formats}")
+        # msh and inp only for a job with a mesh (test_service_mesh)
+        c.check(formats == {"json", "csv", "svg", "vtk", "vtu"}, f"{name}: result links for {formats}")
         for link in results + [lk for lk in info["links"] if lk["rel"] == "statistics"]:
             r = client.get(link["href"])
             c.check(r.status == 200 and r.content_type == link["type"].split(";")[0],

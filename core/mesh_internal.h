@@ -1,0 +1,68 @@
+/* mesh_internal.h - inside the mesh stage: growing arrays, a hash map keyed by point
+ * pairs (segments, edges), and the geometry the stage hands the mesher (the polygons of
+ * the regions as a straight-line graph, and the band's structured strips). */
+#ifndef GRAINPACK_MESH_INTERNAL_H
+#define GRAINPACK_MESH_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/mesh.h"
+#include "mesh_cdt.h"
+
+/* *array (capacity *cap elements of `size` bytes) with room for `need` elements: grown
+ * (the capacity doubled until it fits) when needed. Returns 0 or GP_ENOMEM (the array is
+ * then untouched). */
+int gp_mesh_reserve(void **array, size_t *cap, size_t need, size_t size);
+
+/* An open-addressing hash map from an unordered pair of indices to an int64 value. */
+typedef struct gp_pair_map {
+    uint64_t *keys; /* GP_PAIR_EMPTY where free */
+    int64_t *values;
+    size_t cap, count; /* cap a power of two */
+} gp_pair_map;
+
+#define GP_PAIR_EMPTY UINT64_MAX
+
+/* Room for about `expected` pairs before the first growth. Returns 0 or GP_ENOMEM. */
+int gp_pair_map_init(gp_pair_map *m, size_t expected);
+void gp_pair_map_free(gp_pair_map *m);
+/* The value of pair {a, b}, or NULL when it is not in the map. */
+const int64_t *gp_pair_map_find(const gp_pair_map *m, int32_t a, int32_t b);
+/* The value of pair {a, b}: *found is set to whether it was there; when it was not, it
+ * is inserted with value `fresh`. Returns NULL when out of memory. */
+int64_t *gp_pair_map_get(gp_pair_map *m, int32_t a, int32_t b, int64_t fresh, int *found);
+
+/* The geometry of one mesh: the straight-line graph (grain outlines, domain sides, strip
+ * outlines) with a seed per region, each region's polygon area, and the strips meshed
+ * as structured quadrilaterals. Every array is owned (gp_mesh_geometry_free). */
+typedef struct gp_mesh_geometry {
+    gp_pslg pslg;
+    gp_mesh_kind kind;
+    size_t ngrains;
+    double *region_area;      /* ngrains + 1 */
+    double min_input_angle;   /* degrees: the smallest angle between two segments at a point */
+    int layers;               /* quadrilateral layers across a strip (0: no strips) */
+    size_t nstrips;
+    size_t *strip_start;      /* nstrips + 1 offsets into strip_points */
+    int32_t *strip_points;    /* strip k: (layers + 1) rows of (columns + 1) points, row 0
+                                 on the first grain's edge: the outline's are pslg points,
+                                 the inner ones -1 (the refinement may add columns) */
+    double *strip_thickness;  /* nstrips */
+    size_t strip_start_cap, strip_points_cap, strip_thickness_cap;
+} gp_mesh_geometry;
+
+/* Builds the geometry of `input` for `params` (see gp_mesh_build). Returns 0 or
+ * GP_ENOMEM, GP_ECANCELED, GP_EINVAL (band_layers without offset cells); err says what,
+ * and `out` is zeroed on failure. */
+int gp_mesh_geometry_build(const gp_mesh_input *input, const gp_mesh_params *params,
+                           const gp_progress *progress, gp_mesh_geometry *out, gp_error *err);
+
+void gp_mesh_geometry_free(gp_mesh_geometry *g);
+
+/* Fills mesh->stats from the elements (angles, quality, areas) against the bound
+ * `min_angle` (degrees) and the geometry's polygon areas. */
+void gp_mesh_compute_stats(gp_mesh *mesh, double min_angle, const gp_domain *domain,
+                           double min_input_angle);
+
+#endif
