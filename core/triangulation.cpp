@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <new>
 #include <utility>
@@ -43,9 +44,28 @@ struct gp_rt {
     Rt rt;
     std::vector<Vertex_handle> vertex;                // by disk id
     std::vector<std::pair<Face_handle, int>> edges;   // the flip stack, kept between moves
+    uint8_t *marks = nullptr;                         // borrowed: see gp_rt_mark_changes
 };
 
 namespace {
+
+// Marks the ring of finite vertex v as changed, when the caller asked for marks.
+void mark(const gp_rt &t, Vertex_handle v)
+{
+    if (t.marks && !t.rt.is_infinite(v))
+        t.marks[v->info()] = 1;
+}
+
+// Marks v and every finite vertex around it.
+void mark_star(const gp_rt &t, Vertex_handle v)
+{
+    mark(t, v);
+    Rt::Vertex_circulator c = t.rt.incident_vertices(v), done = c;
+    if (c != nullptr)
+        do
+            mark(t, c);
+        while (++c != done);
+}
 
 // Fills t.rt and t.vertex from the disks; returns 0 or GP_EGEOM (hidden vertex) with err.
 int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
@@ -65,6 +85,8 @@ int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
                                 "regular triangulation: two vertices claim disk %d", id);
         t.vertex[id] = v;
     }
+    if (t.marks)
+        std::fill(t.marks, t.marks + n, uint8_t(1));
     for (size_t i = 0; i < n; i++)
         if (t.vertex[i] == Vertex_handle())
             return gp_error_set(err, GP_EGEOM, NULL,
@@ -77,9 +99,10 @@ int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
 // Lawson's flips from the edges of the faces around v until every edge they reach is
 // locally regular. Returns false when a non-regular edge cannot be flipped (its
 // quadrilateral is not convex) or the flips run away.
-bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int>> &stack,
-                 gp_rt_update_stats &stats)
+bool flip_around(gp_rt &t, Vertex_handle v, gp_rt_update_stats &stats)
 {
+    Rt &rt = t.rt;
+    std::vector<std::pair<Face_handle, int>> &stack = t.edges;
     // every edge whose two triangles have v as a vertex: the link edge and one spoke of
     // each triangle around v (the other spoke is the next triangle's)
     stack.clear();
@@ -107,6 +130,11 @@ bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int
             return false;
         if (++flips > MAX_FLIPS_PER_MOVE)
             return false;
+        // the four vertices of the quadrilateral gain or lose a neighbour
+        mark(t, f->vertex(i));
+        mark(t, f->vertex(Rt::ccw(i)));
+        mark(t, f->vertex(Rt::cw(i)));
+        mark(t, g->vertex(g->index(f)));
         rt.flip(f, i);
         stats.flips++;
         for (int j = 0; j < 3; j++) {
@@ -143,9 +171,12 @@ move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_u
     if (can_move_in_place(t.rt, v, wp.point())) {
         v->set_point(wp);
         stats.moved_in_place++;
-        return flip_around(t.rt, v, t.edges, stats) ? MOVED : NEEDS_REBUILD;
+        return flip_around(t, v, stats) ? MOVED : NEEDS_REBUILD;
     }
-    // remove and insert again: the triangulation stays regular throughout
+    // remove and insert again: the triangulation stays regular throughout. Removing
+    // retriangulates the hole among v's neighbours; inserting flips only edges whose
+    // ends end up around the new vertex: those are all the rings that change.
+    mark_star(t, v);
     Vertex_handle near;
     Rt::Vertex_circulator c = t.rt.incident_vertices(v), done = c;
     do
@@ -157,6 +188,7 @@ move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_u
         return NEEDS_REBUILD; // the rebuild names the disk
     w->info() = id;
     t.vertex[id] = w;
+    mark_star(t, w);
     stats.reinserted++;
     return MOVED;
 }
@@ -206,11 +238,11 @@ extern "C" int gp_rt_dimension(const gp_rt *rt) noexcept
     return rt->rt.dimension();
 }
 
-extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
-                             int *hull) noexcept
+namespace {
+
+// The ring of v as gp_rt_ring gives it (see there).
+size_t ring_of(const Rt &r, Vertex_handle v, int32_t *out, size_t cap, int *hull)
 {
-    const Rt &r = rt->rt;
-    Vertex_handle v = rt->vertex[id];
     *hull = 1;
     if (r.dimension() < 1)
         return 0;
@@ -251,6 +283,48 @@ extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t c
         first = static_cast<size_t>(std::min_element(out, out + n) - out);
     std::rotate(out, out + first, out + n);
     return n;
+}
+
+} // namespace
+
+extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
+                             int *hull) noexcept
+{
+    return ring_of(rt->rt, rt->vertex[id], out, cap, hull);
+}
+
+extern "C" int gp_rt_rings(const gp_rt *rt, size_t *start, uint8_t *hull, int32_t **ids) noexcept
+{
+    const Rt &r = rt->rt;
+    size_t n = rt->vertex.size();
+    *ids = NULL;
+    // both passes walk the vertices in the triangulation's memory order: a vertex and
+    // its faces were allocated together, so the walk stays in cache, where visiting them
+    // by id jumps across the whole triangulation for every ring
+    std::fill(start, start + n + 1, size_t(0));
+    for (Rt::Finite_vertices_iterator v = r.finite_vertices_begin(); v != r.finite_vertices_end(); ++v) {
+        int on_hull;
+        start[v->info() + 1] = ring_of(r, v, NULL, 0, &on_hull);
+    }
+    for (size_t i = 0; i < n; i++)
+        start[i + 1] += start[i];
+    int32_t *out = static_cast<int32_t *>(malloc((start[n] ? start[n] : 1) * sizeof *out));
+    if (!out)
+        return GP_ENOMEM;
+    for (Rt::Finite_vertices_iterator v = r.finite_vertices_begin(); v != r.finite_vertices_end(); ++v) {
+        int32_t id = v->info();
+        int on_hull;
+        ring_of(r, v, out + start[id], start[id + 1] - start[id], &on_hull);
+        if (hull)
+            hull[id] = static_cast<uint8_t>(on_hull);
+    }
+    *ids = out;
+    return 0;
+}
+
+extern "C" void gp_rt_mark_changes(gp_rt *rt, uint8_t *marks) noexcept
+{
+    rt->marks = marks;
 }
 
 extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks,
