@@ -47,11 +47,12 @@ typedef struct balancer {
     double max_step;
     rings rings;        /* the rings of the structure the sweep starts from */
     nearby near;        /* the disks near the positions a centre tries */
-    double *F;          /* F of the structure the sweep starts from (NAN: not interior) */
+    double *F;          /* F of the structure the sweep starts from (NAN: not interior);
+                           the result's array, which holds F of the best one at the end */
     uint8_t *changed;   /* rings the last update changed (gp_rt_mark_changes) */
     uint8_t *stale;     /* F to measure again after the sweep */
-    uint32_t *moved_in; /* the sweep each centre last moved in (0: never) */
-    uint32_t sweep;     /* the sweep under way, from 1 */
+    uint8_t *moved_in;  /* the sweep each centre last moved in, modulo 256 (0: never) */
+    uint8_t sweep;      /* the sweep under way, from 1, modulo 256 */
     double *tangent;    /* x, y of one centre's tangent positions (x NAN: none) */
     size_t tangent_cap; /* positions allocated in tangent */
     int32_t *moved;     /* ids moved in the current sweep, or restored at the end */
@@ -162,7 +163,8 @@ static int step_centre(balancer *b, int32_t id, const int32_t *ring, size_t degr
 
 /* Whether the power cell of interior-looking centre i (not on the hull, three
  * neighbours or more) lies in the domain now: what its F says, unless a neighbour
- * moved earlier in this sweep. */
+ * moved earlier in this sweep. (A neighbour that moved 256 sweeps ago looks as if it
+ * moved in this one: the cell is then tested again, with the same answer.) */
 static int inside_now(const balancer *b, int32_t i, const int32_t *ring, size_t degree)
 {
     for (size_t k = 0; k < degree; k++)
@@ -337,7 +339,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
     out->stop = GP_BALANCE_STOP_CAP;
     for (uint32_t stall = 0; out->sweeps < cap;) {
         double share = 1.0 / cap;
-        b->sweep = out->sweeps + 1;
+        b->sweep = (uint8_t)(out->sweeps + 1);
         if ((rc = sweep(b, progress, share * out->sweeps, share, out, err)))
             return rc;
         out->sweeps++;
@@ -374,7 +376,6 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
     restore_best(b);
     if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, &out->after, err)))
         return rc;
-    memcpy(out->F, b->F, b->n * sizeof *out->F);
     return 0;
 }
 
@@ -406,13 +407,13 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
             goto done;
         out->after = out->before;
     } else {
-        b.F = malloc(m * sizeof *b.F);
+        b.F = out->F;
         b.changed = calloc(m, 1);
         b.stale = calloc(m, 1);
         b.moved_in = calloc(m, sizeof *b.moved_in);
         b.moved = malloc(m * sizeof *b.moved);
         b.best = malloc(2 * m * sizeof *b.best);
-        if (!b.F || !b.changed || !b.stale || !b.moved_in || !b.moved || !b.best) {
+        if (!b.changed || !b.stale || !b.moved_in || !b.moved || !b.best) {
             rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", n);
             goto done;
         }
@@ -425,7 +426,6 @@ done:
     gp_rt_mark_changes(rt, NULL);
     nearby_free(&b.near);
     rings_free(&b.rings);
-    free(b.F);
     free(b.changed);
     free(b.stale);
     free(b.moved_in);

@@ -8,6 +8,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
@@ -96,6 +97,39 @@ int build_into(gp_rt &t, const gp_disk *disks, size_t n, gp_error *err)
     return 0;
 }
 
+// A power test computed in doubles is trusted when it exceeds this fraction of the sum
+// of the absolute values of its terms. Why this value: with every input difference
+// rounded once, the determinant's rounding error stays below about 20 ulps of that sum
+// (2e-15 of it); 1e-12 leaves a margin of hundreds, and a test too close to call goes to
+// CGAL's exact predicate, so the answer is always the exact one.
+const double POWER_TEST_FILTER = 1e-12;
+
+// rt.power_test(f, t) for a finite face f, the sign of CGAL's determinant
+// (power_side_of_oriented_power_circleC2, translated to t), first in plain doubles.
+// CGAL's own filter evaluates it in interval arithmetic, switching the FPU rounding mode
+// each time: a third of the updates' time. Exact either way.
+CGAL::Oriented_side power_test(const Rt &rt, Face_handle f, const Weighted_point &t)
+{
+    const Weighted_point &p = f->vertex(0)->point(), &q = f->vertex(1)->point(), &r = f->vertex(2)->point();
+    double tx = t.x(), ty = t.y(), tw = t.weight();
+    double px = p.x() - tx, py = p.y() - ty, pz = px * px + py * py - p.weight() + tw;
+    double qx = q.x() - tx, qy = q.y() - ty, qz = qx * qx + qy * qy - q.weight() + tw;
+    double rx = r.x() - tx, ry = r.y() - ty, rz = rx * rx + ry * ry - r.weight() + tw;
+    // the lifted coordinates' size before cancellation, for the error bound
+    double pa = px * px + py * py + std::fabs(p.weight()) + std::fabs(tw);
+    double qa = qx * qx + qy * qy + std::fabs(q.weight()) + std::fabs(tw);
+    double ra = rx * rx + ry * ry + std::fabs(r.weight()) + std::fabs(tw);
+    double det = px * (qy * rz - qz * ry) - py * (qx * rz - qz * rx) + pz * (qx * ry - qy * rx);
+    double bound = std::fabs(px) * (std::fabs(qy) * ra + qa * std::fabs(ry)) +
+                   std::fabs(py) * (std::fabs(qx) * ra + qa * std::fabs(rx)) +
+                   pa * (std::fabs(qx * ry) + std::fabs(qy * rx));
+    if (det > POWER_TEST_FILTER * bound)
+        return CGAL::ON_POSITIVE_SIDE;
+    if (det < -POWER_TEST_FILTER * bound)
+        return CGAL::ON_NEGATIVE_SIDE;
+    return rt.power_test(f, t);
+}
+
 // Lawson's flips from the edges of the faces around v until every edge they reach is
 // locally regular. Returns false when a non-regular edge cannot be flipped (its
 // quadrilateral is not convex) or the flips run away.
@@ -121,7 +155,7 @@ bool flip_around(gp_rt &t, Vertex_handle v, gp_rt_update_stats &stats)
         if (rt.is_infinite(f) || rt.is_infinite(g))
             continue; // hull edges: the hull does not change, see gp_rt_update_moved
         const Weighted_point &d = g->vertex(g->index(f))->point();
-        if (rt.power_test(f, d) != CGAL::ON_POSITIVE_SIDE)
+        if (power_test(rt, f, d) != CGAL::ON_POSITIVE_SIDE)
             continue; // locally regular (or exactly co-power-circular: either diagonal)
         const Weighted_point &a = f->vertex(i)->point();
         const Weighted_point &b = f->vertex(Rt::ccw(i))->point();

@@ -2,7 +2,7 @@
  * the hull where the header says, the empty-power-circle property checked by brute force,
  * hidden vertices reported, degenerate inputs, all the rings at once, and updates after
  * moves (flips, reinsertion, rebuild) that end in the same triangulation as a fresh build
- * and mark every ring they change. */
+ * and mark every ring they change, and stay regular through moves of a few ulps. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -357,6 +357,43 @@ static void test_updates_after_moves_match_a_fresh_build(void)
     gp_spec_free(&spec);
 }
 
+/* Moves of a few ulps on a square grid, where every four neighbours share a power circle
+ * exactly: the power tests of the flips are as close to zero as doubles allow, where a
+ * test computed in doubles alone would misjudge the sign; the update must still end in a
+ * regular triangulation (checked with CGAL's exact predicates). */
+static void test_updates_stay_regular_on_near_ties(void)
+{
+    enum { SIDE = 8 };
+    /* a pitch and an origin that doubles do not hold exactly: the lifted coordinates of
+     * the tests are rounded, and their errors are of the size of the moves */
+    const double pitch = 0.3, x0 = 10.1, y0 = 20.7;
+    gp_disk d[SIDE * SIDE];
+    for (int i = 0; i < SIDE * SIDE; i++)
+        d[i] = (gp_disk){x0 + pitch * (i % SIDE), y0 + pitch * (i / SIDE), 0.13, 0.13};
+    gp_rt *rt;
+    gp_error err;
+    CHECK(gp_rt_build(d, SIDE * SIDE, &rt, &err) == 0);
+    gp_rng rng;
+    gp_rng_seed(&rng, 11);
+    int32_t ids[SIDE * SIDE];
+    for (int round = 0; round < 40; round++) {
+        size_t moved = 0;
+        for (int i = 0; i < SIDE * SIDE; i++) {
+            if (gp_rng_uniform(&rng) < 0.5)
+                continue;
+            /* back to the grid every fourth round (ties), else up to 3 ulps of 16 off it */
+            double ulp = 0x1p-48, kx = round % 4 ? floor(7.0 * gp_rng_uniform(&rng)) - 3.0 : 0.0,
+                   ky = round % 4 ? floor(7.0 * gp_rng_uniform(&rng)) - 3.0 : 0.0;
+            d[i].x = x0 + pitch * (i % SIDE) + kx * ulp;
+            d[i].y = y0 + pitch * (i / SIDE) + ky * ulp;
+            ids[moved++] = i;
+        }
+        CHECK(gp_rt_update_moved(rt, d, SIDE * SIDE, ids, moved, GP_RT_UPDATE_FLIPS, NULL, &err) == 0);
+        CHECK_MSG(gp_rt_is_regular(rt), "round %d", round);
+    }
+    gp_rt_free(rt);
+}
+
 int main(void)
 {
     RUN(test_hexagonal_patch_rings_are_six_touching_neighbours_ccw);
@@ -365,5 +402,6 @@ int main(void)
     RUN(test_degenerate_inputs_have_rings_too);
     RUN(test_all_rings_at_once_are_the_rings_one_by_one);
     RUN(test_updates_after_moves_match_a_fresh_build);
+    RUN(test_updates_stay_regular_on_near_ties);
     return check_status();
 }
