@@ -28,6 +28,7 @@ static json_t *bins_json(const gp_bin_stat *table, size_t nbins, int *failed)
         put(bin, "target", json_real(b->target), failed);
         put(bin, "count", json_integer((json_int_t)b->count), failed);
         put(bin, "achieved", json_real(b->achieved), failed);
+        put(bin, "se", json_real(b->se), failed);
         put(bin, "z", json_real(b->z), failed);
         if (json_array_append_new(bins, bin))
             *failed = 1;

@@ -55,8 +55,8 @@ void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_
     for (size_t i = 0; i < nbins; i++) {
         gp_bin_stat *b = &bins[i];
         b->achieved = n ? (double)b->count / (double)n : 0.0;
-        double se = n ? sqrt(b->target * (1.0 - b->target) / (double)n) : 0.0;
-        b->z = se > 0.0 ? (b->achieved - b->target) / se : 0.0;
+        b->se = n ? sqrt(b->target * (1.0 - b->target) / (double)n) : 0.0;
+        b->z = b->se > 0.0 ? (b->achieved - b->target) / b->se : 0.0;
         if (fabs(b->z) > *max_abs_z)
             *max_abs_z = fabs(b->z);
     }

@@ -1,5 +1,6 @@
-/* http.c - libmicrohttpd callbacks: connections per address, gathering the request,
- * admission (router.c), the route call, CORS, the response, and the per-request log
+/* http.c - the adapter between libmicrohttpd and the router: connections per address,
+ * gathering the request into a gp_request (request.h), admission and the route call
+ * (router.c), the gp_reply turned into a response with CORS, and the per-request log
  * line. */
 #include "http.h"
 
@@ -42,7 +43,9 @@ typedef struct request_state {
     const char *owner;
     char *body;
     size_t len, cap;
-    int too_large;   /* the body passed the cap: it is dropped, 413 answers */
+    int dropping;    /* the body is read and dropped: it passed the cap (413 answers) or
+                        memory ran out (the out-of-memory 503 answers) */
+    int no_memory;   /* why it is dropped: memory ran out (gather) */
     size_t discarded;
     int answered;    /* a response was queued */
     int suspended;   /* a long-poll is waiting */
@@ -52,19 +55,44 @@ typedef struct request_state {
     double t0;
 } request_state;
 
-const char *gp_request_query(const gp_request *req, const char *name)
+static const char *mhd_header(void *conn, const char *name)
 {
-    return MHD_lookup_connection_value(req->conn, MHD_GET_ARGUMENT_KIND, name);
+    return MHD_lookup_connection_value(conn, MHD_HEADER_KIND, name);
 }
 
-const char *gp_request_header(const gp_request *req, const char *name)
+static const char *mhd_query(void *conn, const char *name)
 {
-    return MHD_lookup_connection_value(req->conn, MHD_HEADER_KIND, name);
+    return MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
-const char *gp_request_submitter(const gp_request *req)
+static const gp_request_ops mhd_request_ops = {mhd_header, mhd_query};
+
+static void mhd_suspend(void *conn)
 {
-    return req->who ? req->who->user : "";
+    MHD_suspend_connection(conn);
+}
+
+static void mhd_resume(void *conn)
+{
+    MHD_resume_connection(conn);
+}
+
+const gp_suspender gp_http_suspender = {mhd_suspend, mhd_resume};
+
+/* The gp_request of a libmicrohttpd request as far as st has it (no body: the caller
+ * adds it once it is in). */
+static gp_request make_request(gp_service *svc, struct MHD_Connection *conn, const char *method,
+                               const char *url, const request_state *st)
+{
+    return (gp_request){.svc = svc,
+                        .ops = &mhd_request_ops,
+                        .conn = conn,
+                        .method = method,
+                        .path = url,
+                        .id = st->id,
+                        .resumed = st->suspended,
+                        .who = st->who_ptr,
+                        .owner = st->owner};
 }
 
 /* Adds the CORS headers when the request comes from an allowed origin. */
@@ -90,18 +118,31 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     }
 }
 
+/* A response holding reply's body (it is the response's once this returns non-NULL). */
+static struct MHD_Response *create_response(gp_reply *reply)
+{
+    int owned = reply->body && !reply->persistent;
+    struct MHD_Response *resp = MHD_create_response_from_buffer(
+        reply->len, reply->body ? reply->body : (void *)"",
+        owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+    if (resp && owned)
+        reply->body = NULL;
+    return resp;
+}
+
 /* Queues reply as the response (taking its body), logs and counts the request. */
 static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, request_state *st,
                                gp_reply *reply, int preflight)
 {
-    struct MHD_Response *resp =
-        MHD_create_response_from_buffer(reply->len, reply->body ? reply->body : (void *)"",
-                                        reply->body ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+    struct MHD_Response *resp = create_response(reply);
+    if (!resp) { /* out of memory: the static problem needs no copy of its body */
+        gp_problem_out_of_memory(reply);
+        resp = create_response(reply);
+    }
     if (!resp) {
         gp_reply_free(reply);
         return MHD_NO;
     }
-    reply->body = NULL; /* now the response's */
     if (reply->content_type)
         MHD_add_response_header(resp, "Content-Type", reply->content_type);
     if (reply->location[0])
@@ -117,6 +158,17 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
     }
     if (reply->close)
         MHD_add_response_header(resp, "Connection", "close");
+    if (reply->vary)
+        MHD_add_response_header(resp, "Vary", reply->vary);
+    if (reply->cache_control)
+        MHD_add_response_header(resp, "Cache-Control", reply->cache_control);
+    if (reply->etag)
+        MHD_add_response_header(resp, "ETag", reply->etag);
+    if (reply->csp) { /* the web page's files: no sniffing, no framing, no referrer */
+        MHD_add_response_header(resp, "Content-Security-Policy", reply->csp);
+        MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
+        MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
+    }
     add_cors(svc, conn, resp, st->route, preflight);
     enum MHD_Result rc = MHD_queue_response(conn, reply->status, resp);
     MHD_destroy_response(resp);
@@ -128,7 +180,8 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
     return rc;
 }
 
-/* Appends upload data under the cap. Returns 0, or 1 when the cap was passed. */
+/* Appends upload data under the cap. Returns 0, or 1 when the cap was passed or memory
+ * ran out (then st->no_memory is set). */
 static int gather(gp_service *svc, request_state *st, const char *data, size_t size)
 {
     if (st->len + size > svc->cfg->max_body)
@@ -138,8 +191,10 @@ static int gather(gp_service *svc, request_state *st, const char *data, size_t s
         while (cap < st->len + size)
             cap *= 2;
         char *grown = realloc(st->body, cap);
-        if (!grown)
+        if (!grown) {
+            st->no_memory = 1;
             return 1;
+        }
         st->body = grown;
         st->cap = cap;
     }
@@ -180,7 +235,7 @@ static enum MHD_Result begin_request(gp_service *svc, struct MHD_Connection *con
     MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, add_size, &uri_bytes);
     MHD_get_connection_values(conn, MHD_HEADER_KIND, add_size, &header_bytes);
     st->route = gp_router_match(url, st->id);
-    gp_request req = {svc, conn, method, url, st->id, NULL, 0, 0, NULL, NULL};
+    gp_request req = make_request(svc, conn, method, url, st);
     int answered = gp_router_admit(&req, st->route, uri_bytes, header_bytes, &st->who, &reply);
     st->who_ptr = req.who ? &st->who : NULL;
     if (answered)
@@ -215,9 +270,9 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
          * sending far past the cap, or too slowly, is cut off. */
         size_t size = *upload_size;
         *upload_size = 0;
-        if (!st->too_large && gather(svc, st, upload_data, size))
-            st->too_large = 1;
-        if (st->too_large && (st->discarded += size) > DISCARD_FACTOR * svc->cfg->max_body)
+        if (!st->dropping && gather(svc, st, upload_data, size))
+            st->dropping = 1;
+        if (st->dropping && (st->discarded += size) > DISCARD_FACTOR * svc->cfg->max_body)
             return MHD_NO;
         if (gp_monotonic_seconds() - st->t0 >
             (double)(BODY_DEADLINE_FACTOR * svc->cfg->connection_timeout)) {
@@ -227,19 +282,21 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         }
         return MHD_YES;
     }
-    if (st->too_large) {
+    if (st->no_memory) {
+        gp_problem_out_of_memory(&reply);
+        return respond(svc, conn, st, &reply, 0);
+    }
+    if (st->dropping) {
         gp_problem(&reply, 413, GP_PROBLEM_BODY_TOO_LARGE, url,
                    "the body is larger than the limit of %zu bytes (--max-body)",
                    svc->cfg->max_body);
         return respond(svc, conn, st, &reply, 0);
     }
-    const gp_route_entry *rt = st->route;
-    int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    gp_route_fn fn = is_get ? rt->get : strcmp(method, "POST") == 0 ? rt->post : rt->del;
-    gp_request req = {svc,     conn,          method,      url,      st->id, st->body ? st->body : "",
-                      st->len, st->suspended, st->who_ptr, st->owner};
+    gp_request req = make_request(svc, conn, method, url, st);
+    req.body = st->body ? st->body : "";
+    req.body_len = st->len;
     st->suspended = 0;
-    if (fn(&req, &reply) == GP_ROUTE_SUSPENDED) {
+    if (gp_router_call(st->route, &req, &reply) == GP_ROUTE_SUSPENDED) {
         st->suspended = 1;
         return MHD_YES;
     }

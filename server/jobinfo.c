@@ -3,7 +3,10 @@
 
 #include <stdio.h>
 
+#include "grainpack/io.h"
 #include "routes.h"
+
+#define OGC_RESULTS_REL "http://www.opengis.net/def/rel/ogc/1.0/results"
 
 static void put_time(json_t *obj, const char *key, const char *value)
 {
@@ -22,8 +25,21 @@ json_t *gp_job_status_info(const gp_job *job)
     if (links && job->status == GP_JOB_SUCCESSFUL) {
         json_array_append_new(links,
                               json_pack("{s:s, s:s, s:s, s:s}", "href", results, "rel",
-                                        "http://www.opengis.net/def/rel/ogc/1.0/results", "type",
+                                        OGC_RESULTS_REL, "type",
                                         "application/json", "title", "the result (?f= picks the format)"));
+        /* the other formats, one link each, so that a client lists the downloads without
+         * knowing them: a format the engine gains appears here by itself */
+        for (size_t i = 0; i < gp_format_count(); i++) {
+            gp_format f = (gp_format)i;
+            if (f == GP_FORMAT_JSON)
+                continue;
+            char href[96], title[48];
+            snprintf(href, sizeof href, "%s?f=%s", results, gp_format_name(f));
+            snprintf(title, sizeof title, "the result as %s", gp_format_name(f));
+            json_array_append_new(links, json_pack("{s:s, s:s, s:s, s:s}", "href", href, "rel",
+                                                   OGC_RESULTS_REL, "type", gp_format_media_type(f),
+                                                   "title", title));
+        }
         json_array_append_new(links, json_pack("{s:s, s:s, s:s, s:s}", "href", stats, "rel",
                                                "statistics", "type", "application/json", "title",
                                                "densities, distribution fidelity, timings"));

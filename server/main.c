@@ -123,7 +123,7 @@ int main(int argc, char **argv)
     gp_store_release(svc.store, db);
     atomic_store(&svc.queued, counts[GP_JOB_ACCEPTED]);
     if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
-        gp_waiters_start(&svc.waiters) || gp_pool_start(&svc, &svc.pool)) {
+        gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");
         goto done;
     }

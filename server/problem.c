@@ -92,8 +92,22 @@ static void build(gp_reply *reply, unsigned status, const char *type, const char
     set_text(p, "instance", instance);
     set_text(p, "pointer", pointer);
     set_text(p, "expected", expected);
-    if (gp_reply_json(reply, status, GP_PROBLEM_MEDIA_TYPE, p))
-        reply->status = status; /* out of memory: at least the status is right */
+    gp_reply_json(reply, status, GP_PROBLEM_MEDIA_TYPE, p); /* or the out-of-memory 503 */
+}
+
+/* 503: running out of memory is passing (other requests free theirs), so the client is
+ * told to try again rather than that the request is wrong. */
+static const char out_of_memory_body[] =
+    "{\"type\":\"" GP_PROBLEM_INTERNAL "\",\"title\":\"Service Unavailable\",\"status\":503,"
+    "\"detail\":\"the service ran out of memory while answering this request; "
+    "try again in a few seconds\"}";
+
+void gp_problem_out_of_memory(gp_reply *reply)
+{
+    gp_reply_take(reply, 503, GP_PROBLEM_MEDIA_TYPE, (char *)out_of_memory_body,
+                  sizeof out_of_memory_body - 1);
+    reply->persistent = 1;
+    reply->retry_after = GP_RETRY_AFTER_SECONDS;
 }
 
 void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *instance,

@@ -41,7 +41,7 @@
  * printf-style detail. `instance` (the request path) may be NULL. Text that came from
  * the request (a path, a parameter) may be any bytes: detail and instance are made valid
  * UTF-8 without control characters first (each offending byte becomes U+FFFD), so that
- * the body is always JSON. */
+ * the body is always JSON. When memory runs out, the reply is gp_problem_out_of_memory's. */
 void gp_problem(gp_reply *reply, unsigned status, const char *type, const char *instance,
                 const char *detail_fmt, ...)
 #if defined(__GNUC__)
@@ -59,6 +59,11 @@ void gp_problem_store_unavailable(gp_reply *reply, const char *instance);
  * disk is full (GP_SRV_EFULL), the database cannot be written (GP_SRV_EUNWRITABLE) or it
  * failed otherwise; `action` says what did not happen ("the job was not stored"). */
 void gp_problem_store_error(gp_reply *reply, const char *instance, int rc, const char *action);
+
+/* Makes reply a 503 problem (with Retry-After) saying that the service ran out of memory
+ * while answering, from a static preformatted body: it allocates nothing, so that the
+ * answer is still application/problem+json when building the real one failed. */
+void gp_problem_out_of_memory(gp_reply *reply);
 
 /* Copies text into out (size bytes, NUL-terminated, cut at a character boundary) as
  * valid UTF-8 without control characters: each offending byte becomes U+FFFD. */

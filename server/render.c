@@ -45,8 +45,7 @@ static int range_match(const char *r, size_t n, const char *mt)
     return 0;
 }
 
-/* The q of the most specific range of `accept` matching mt (0 when none does). */
-static double accept_quality(const char *accept, const char *mt)
+double gp_accept_quality(const char *accept, const char *mt)
 {
     int best_spec = 0;
     double q_best = 0.0;
@@ -94,7 +93,7 @@ int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *rep
         return 0;
     double best = 0.0;
     for (size_t i = 0; i < gp_format_count(); i++) {
-        double q = accept_quality(accept, gp_format_media_type((gp_format)i));
+        double q = gp_accept_quality(accept, gp_format_media_type((gp_format)i));
         if (q > best) { /* ties keep the earlier format: JSON first */
             best = q;
             *out = (gp_format)i;

@@ -7,13 +7,17 @@
 #define GRAINPACKD_RENDER_H
 
 #include "grainpack/io.h"
-#include "http.h"
+#include "request.h"
 #include "store.h"
 
 /* Picks the format: ?f=NAME wins, else the best match of the Accept header (q-values,
  * type/any and any/any honoured), else JSON. Returns 0, or -1 with reply filled (400 for an
  * unknown f, 406 when Accept allows none). */
 int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *reply);
+
+/* The q that an Accept header gives media type mt: that of its most specific matching
+ * range (exact, type/any, any/any), 0 when none matches. */
+double gp_accept_quality(const char *accept, const char *mt);
 
 /* Rebuilds the spec and result of a successful job of `owner` (NULL: any owner; see
  * store.h). On success returns 0 and the caller frees both (gp_spec_free,

@@ -5,14 +5,14 @@
 #include <string.h>
 
 #include "grainpack/error.h"
+#include "problem.h"
 
 int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, json_t *value)
 {
     char *text = value ? json_dumps(value, JSON_COMPACT | JSON_REAL_PRECISION(17)) : NULL;
     json_decref(value);
     if (!text) {
-        reply->status = 500;
-        reply->content_type = "text/plain";
+        gp_problem_out_of_memory(reply);
         return GP_ENOMEM;
     }
     gp_reply_take(reply, status, content_type, text, strlen(text));
@@ -22,11 +22,13 @@ int gp_reply_json(gp_reply *reply, unsigned status, const char *content_type, js
 void gp_reply_take(gp_reply *reply, unsigned status, const char *content_type, char *body,
                    size_t len)
 {
-    free(reply->body);
+    if (!reply->persistent)
+        free(reply->body);
     reply->status = status;
     reply->content_type = content_type;
     reply->body = body;
     reply->len = len;
+    reply->persistent = 0;
 }
 
 int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, const char *text,
@@ -34,7 +36,7 @@ int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, co
 {
     char *copy = malloc(len ? len : 1);
     if (!copy) {
-        reply->status = 500;
+        gp_problem_out_of_memory(reply);
         return GP_ENOMEM;
     }
     memcpy(copy, text, len);
@@ -44,6 +46,7 @@ int gp_reply_text(gp_reply *reply, unsigned status, const char *content_type, co
 
 void gp_reply_free(gp_reply *reply)
 {
-    free(reply->body);
+    if (!reply->persistent)
+        free(reply->body);
     memset(reply, 0, sizeof *reply);
 }

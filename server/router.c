@@ -17,6 +17,7 @@ static const gp_route_entry routes[] = {
     {"/processes", GP_ACCESS_PUBLIC, gp_route_processes, NULL, NULL},
     {"/processes/{}", GP_ACCESS_PUBLIC, gp_route_process, NULL, NULL},
     {"/processes/{}/execution", GP_ACCESS_KEY, NULL, gp_route_execute, NULL},
+    {"/processes/{}/validation", GP_ACCESS_KEY, NULL, gp_route_validate, NULL},
     {"/jobs", GP_ACCESS_KEY, gp_route_jobs, NULL, NULL},
     {"/jobs/{}", GP_ACCESS_KEY, gp_route_job, NULL, gp_route_dismiss},
     {"/jobs/{}/results", GP_ACCESS_KEY, gp_route_results, NULL, NULL},
@@ -24,6 +25,7 @@ static const gp_route_entry routes[] = {
     {"/health", GP_ACCESS_PUBLIC, gp_route_health, NULL, NULL},
     {"/metrics", GP_ACCESS_ADMIN, gp_route_metrics, NULL, NULL},
     {"/openapi.yaml", GP_ACCESS_PUBLIC, gp_route_openapi, NULL, NULL},
+    {"/ui/{}", GP_ACCESS_PUBLIC, gp_route_web_file, NULL, NULL},
 };
 #define NROUTES (sizeof routes / sizeof routes[0])
 
@@ -192,4 +194,12 @@ int gp_router_admit(gp_request *req, const gp_route_entry *rt, size_t uri_bytes,
         return 1;
     }
     return 0;
+}
+
+int gp_router_call(const gp_route_entry *rt, gp_request *req, gp_reply *reply)
+{
+    const char *method = req->method;
+    int is_get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    gp_route_fn fn = is_get ? rt->get : strcmp(method, "POST") == 0 ? rt->post : rt->del;
+    return fn(req, reply);
 }

@@ -1,13 +1,13 @@
 /* router.h - the route table and the checks a request passes once its headers are in,
  * before any body is read: sizes, path, method, API key and role, media type and length.
- * http.c calls these; they see the request only through gp_request, so that they do not
- * depend on how it arrived. */
+ * http.c calls these; they see the request only through gp_request (request.h), so that
+ * they do not depend on how it arrived and are tested without an HTTP library. */
 #ifndef GRAINPACKD_ROUTER_H
 #define GRAINPACKD_ROUTER_H
 
 #include <stddef.h>
 
-#include "http.h"
+#include "request.h"
 
 /* The longest id segment accepted; job ids are 36 characters. */
 #define GP_ID_MAX 64
@@ -43,5 +43,10 @@ void gp_router_allow(const gp_route_entry *rt, char *out, size_t size);
  * goes on (then req->who and req->owner are set). `who` is storage for the identity. */
 int gp_router_admit(gp_request *req, const gp_route_entry *rt, size_t uri_bytes,
                     size_t header_bytes, gp_identity *who, gp_reply *reply);
+
+/* Calls the route's function for req->method (HEAD is GET's) once the request passed
+ * gp_router_admit and its body is in. Returns what the route did: GP_ROUTE_DONE with
+ * reply filled, or GP_ROUTE_SUSPENDED. */
+int gp_router_call(const gp_route_entry *rt, gp_request *req, gp_reply *reply);
 
 #endif

@@ -1,6 +1,7 @@
-/* routes_jobs.c - submitting a job, listing jobs, following one (with the long-poll),
- * dismissing or deleting it. */
+/* routes_jobs.c - checking a spec, submitting a job, listing jobs, following one (with
+ * the long-poll), dismissing or deleting it. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +38,45 @@ static int query_count(const gp_request *req, const char *name, long long lo, lo
     return 0;
 }
 
+/* Parses the body as a spec under the service's caps. Returns 0 with spec filled (the
+ * caller frees it), or -1 with the 400/422 problem in reply. */
+static int parse_spec(gp_request *req, gp_spec *spec, gp_reply *reply)
+{
+    gp_spec_limits limits = {req->svc->cfg->max_disks, req->svc->cfg->max_bins};
+    gp_error err;
+    gp_error_clear(&err);
+    if (gp_spec_parse(req->body, req->body_len, &limits, spec, &err)) {
+        gp_problem_from_spec_error(reply, req->path, &err);
+        return -1;
+    }
+    return 0;
+}
+
+int gp_route_validate(gp_request *req, gp_reply *reply)
+{
+    gp_service *svc = req->svc;
+    gp_spec spec;
+    if (strcmp(req->id, GP_PROCESS_ID) != 0) {
+        gp_problem_no_such_process(reply, req->path, req->id);
+        return GP_ROUTE_DONE;
+    }
+    if (parse_spec(req, &spec, reply))
+        return GP_ROUTE_DONE;
+    /* nothing is stored or queued: the answer is what a submission would be accepted as */
+    json_t *body = json_pack("{s:b, s:I, s:o*, s:{s:I, s:I}}", "valid", 1, "expected_disks",
+                             (json_int_t)llround(spec.expected_disks), "inputs", gp_spec_json(&spec),
+                             "limits", "max_disks", (json_int_t)svc->cfg->max_disks, "max_bins",
+                             (json_int_t)svc->cfg->max_bins);
+    gp_spec_free(&spec);
+    if (!body || !json_object_get(body, "inputs")) {
+        json_decref(body);
+        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory");
+        return GP_ROUTE_DONE;
+    }
+    gp_reply_json(reply, 200, JSON_TYPE, body);
+    return GP_ROUTE_DONE;
+}
+
 int gp_route_execute(gp_request *req, gp_reply *reply)
 {
     gp_service *svc = req->svc;
@@ -50,14 +90,9 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
-    gp_spec_limits limits = {svc->cfg->max_disks, svc->cfg->max_bins};
     gp_spec spec;
-    gp_error err;
-    gp_error_clear(&err);
-    if (gp_spec_parse(req->body, req->body_len, &limits, &spec, &err)) {
-        gp_problem_from_spec_error(reply, req->path, &err);
+    if (parse_spec(req, &spec, reply))
         return GP_ROUTE_DONE;
-    }
     /* reserve a queue place first, so that concurrent submissions cannot overshoot */
     long before = atomic_fetch_add(&svc->queued, 1);
     if (before >= (long)svc->cfg->max_queued) {
@@ -139,7 +174,7 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
         return GP_ROUTE_DONE;
     gp_job *jobs = malloc((size_t)limit * sizeof *jobs);
     if (!jobs) {
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory");
+        gp_problem_out_of_memory(reply);
         return GP_ROUTE_DONE;
     }
     size_t n = 0;

@@ -21,14 +21,18 @@ static json_t *make_link(const char *href, const char *rel, const char *type, co
 
 int gp_route_landing(gp_request *req, gp_reply *reply)
 {
-    (void)req;
+    reply->vary = "Accept"; /* the page for a browser, this document for the others */
+    int page = gp_route_web_wants_page(req, reply);
+    if (page)
+        return page < 0 ? GP_ROUTE_DONE : gp_route_web_page(req, reply);
     json_t *body = json_pack(
-        "{s:s, s:s, s:[o, o, o, o, o, o, o]}", "title", "grainpack",
+        "{s:s, s:s, s:[o, o, o, o, o, o, o, o]}", "title", "grainpack",
         "description",
         "Packs a rectangle with disks whose radii follow a distribution (advancing-front "
         "method of INRIA report RR-6414), as asynchronous jobs in the style of OGC API - "
         "Processes.",
         "links", make_link("/", "self", JSON_TYPE, "this document"),
+        make_link("/?f=html", "alternate", "text/html", "the web page: design, run and look at jobs"),
         make_link("/openapi.yaml", "service-desc", "application/vnd.oai.openapi;version=3.1",
              "the API definition (OpenAPI 3.1)"),
         make_link("/conformance", OGC_REL "conformance", JSON_TYPE, "conformance classes"),

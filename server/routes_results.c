@@ -48,18 +48,41 @@ static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp
     int rc = gp_render_load(db, req->id, req->owner, spec, result);
     if (rc == GP_SRV_ENOTFOUND) /* deleted between the two reads */
         return without_result(req, db, reply);
+    if (rc == GP_ENOMEM) {
+        gp_problem_out_of_memory(reply);
+        return 1;
+    }
     if (rc) {
         gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path,
-                   "the stored result of job %s could not be read (%d)", req->id, rc);
+                   "the stored result of job %s could not be read: %s", req->id,
+                   gp_srv_strerror(rc));
         return 1;
     }
     return 0;
 }
 
+/* Reads ?color=radius|quality, what the picture is coloured by (the spec's choice when
+ * absent). Returns 0 with *color set, or -1 with a 400 in reply. */
+static int picture_color(const gp_request *req, int *color, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, "color");
+    *color = -1;
+    if (!text)
+        return 0;
+    if (strcmp(text, "radius") == 0 || strcmp(text, "quality") == 0) {
+        *color = strcmp(text, "radius") == 0 ? GP_PICTURE_COLOR_RADIUS : GP_PICTURE_COLOR_QUALITY;
+        return 0;
+    }
+    gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+               "color must be radius or quality (F, for a job that balanced), got '%.40s'", text);
+    return -1;
+}
+
 int gp_route_results(gp_request *req, gp_reply *reply)
 {
     gp_format format;
-    if (gp_render_choose_format(req, &format, reply))
+    int color;
+    if (gp_render_choose_format(req, &format, reply) || picture_color(req, &color, reply))
         return GP_ROUTE_DONE;
     gp_spec spec;
     gp_result result;
@@ -68,13 +91,26 @@ int gp_route_results(gp_request *req, gp_reply *reply)
     gp_store_release(req->svc->store, db);
     if (missing)
         return GP_ROUTE_DONE;
+    if (color == GP_PICTURE_COLOR_QUALITY && !result.has_balance) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "color=quality colours the grains by F, which only a job that balances has; "
+                   "job %s has no balance stage (color=radius)", req->id);
+        gp_result_free(&result);
+        gp_spec_free(&spec);
+        return GP_ROUTE_DONE;
+    }
+    if (color >= 0)
+        spec.picture_color = (gp_picture_color)color;
     char *body;
     size_t len;
-    if (gp_render_format(&spec, &result, format, &body, &len) == 0)
+    int rc = gp_render_format(&spec, &result, format, &body, &len);
+    if (rc == 0)
         gp_reply_take(reply, 200, gp_format_media_type(format), body, len);
+    else if (rc == GP_ENOMEM)
+        gp_problem_out_of_memory(reply);
     else
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "rendering %s failed",
-                   gp_format_name(format));
+        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "rendering %s failed: %s",
+                   gp_format_name(format), gp_strerror(rc));
     gp_result_free(&result);
     gp_spec_free(&spec);
     return GP_ROUTE_DONE;

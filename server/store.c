@@ -130,6 +130,19 @@ int gp_db_fail(gp_db *db, const char *what)
     return rc;
 }
 
+const char *gp_srv_strerror(int code)
+{
+    switch (code) {
+    case GP_SRV_ENOTFOUND: return "no such job";
+    case GP_SRV_ESTATE: return "the job is not in the state this needs";
+    case GP_SRV_EDB: return "the database failed";
+    case GP_SRV_EFULL: return "the database's disk is full";
+    case GP_SRV_EUNWRITABLE: return "the database cannot be written";
+    case GP_SRV_ELIMIT: return "too many active jobs";
+    default: return gp_strerror(code);
+    }
+}
+
 static void db_close(gp_db *db)
 {
     if (!db)
@@ -195,33 +208,56 @@ sqlite3_stmt *gp_db_stmt(gp_db *db, enum stmt_id id)
     return db->stmt[id];
 }
 
-int gp_db_step(sqlite3_stmt *s)
+/* Steps s once and resets it: 0 (a row or done) or GP_SRV_EDB. */
+static int step(sqlite3_stmt *s)
 {
     int rc = sqlite3_step(s);
     sqlite3_reset(s);
     return rc == SQLITE_DONE || rc == SQLITE_ROW ? 0 : GP_SRV_EDB;
 }
 
-int gp_db_begin(gp_db *db)
+int gp_db_run(gp_db *db, sqlite3_stmt *s, const char *what)
 {
-    return gp_db_step(db->begin) ? gp_db_fail(db, "begin immediate") : 0;
+    return step(s) ? gp_db_fail(db, what) : 0;
 }
 
-int gp_db_commit(gp_db *db)
+int gp_db_run_one(gp_db *db, sqlite3_stmt *s, const char *what)
 {
-    if (gp_db_step(db->commit) == 0) {
+    int rc = gp_db_run(db, s, what);
+    return rc == 0 && sqlite3_changes(db->conn) == 0 ? GP_SRV_ESTATE : rc;
+}
+
+/* ROLLBACK when a transaction is open. */
+static void rollback(gp_db *db)
+{
+    if (!sqlite3_get_autocommit(db->conn))
+        step(db->rollback);
+}
+
+sqlite3_stmt *gp_db_write(gp_db *db, enum stmt_id id, int *rc)
+{
+    sqlite3_stmt *s = gp_db_stmt(db, id);
+    if (!s) {
+        *rc = GP_SRV_EDB;
+        return NULL;
+    }
+    *rc = gp_db_run(db, db->begin, "begin immediate");
+    return *rc ? NULL : s;
+}
+
+int gp_db_end(gp_db *db, int rc)
+{
+    if (rc) {
+        rollback(db);
+        return rc;
+    }
+    if (step(db->commit) == 0) {
         set_write_state(db->store, 0);
         return 0;
     }
-    int rc = gp_db_fail(db, "commit");
-    gp_db_step(db->rollback);
+    rc = gp_db_fail(db, "commit");
+    step(db->rollback);
     return rc;
-}
-
-void gp_db_rollback(gp_db *db)
-{
-    if (!sqlite3_get_autocommit(db->conn))
-        gp_db_step(db->rollback);
 }
 
 static int exec_sql(sqlite3 *conn, const char *sql, char *why, size_t why_size)
@@ -382,7 +418,7 @@ void gp_store_release(gp_store *store, gp_db *db)
 {
     if (!db)
         return;
-    gp_db_rollback(db); /* a caller that bailed out mid-transaction must not hold the write lock */
+    rollback(db); /* a caller that bailed out mid-transaction must not hold the write lock */
     if (gp_store_broken(db)) {
         pthread_mutex_lock(&store->lock);
         for (size_t i = 0; i < store->nall; i++) {

@@ -24,6 +24,10 @@ enum {
     GP_SRV_ELIMIT = -105     /* the owner has as many active jobs as allowed */
 };
 
+/* A short constant English text for a service or engine code, for users and logs (never
+ * the number): "the database failed", ..., gp_strerror's text for the engine's codes. */
+const char *gp_srv_strerror(int code);
+
 /* The schema version this build migrates to (PRAGMA user_version). */
 #define GP_STORE_SCHEMA_VERSION 2
 

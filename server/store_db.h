@@ -48,19 +48,34 @@ struct gp_db {
  * gp_db_fail) when sqlite cannot prepare it. Owned by db. */
 sqlite3_stmt *gp_db_stmt(gp_db *db, enum stmt_id id);
 
-/* Steps s once and resets it: 0 (a row or done) or GP_SRV_EDB. */
-int gp_db_step(sqlite3_stmt *s);
-
 /* Logs db's last failure with `what` and returns its class: GP_SRV_EFULL,
  * GP_SRV_EUNWRITABLE or GP_SRV_EDB. A connection that met an I/O or permission error is
  * marked broken (closed when released), and the store's write state follows. */
 int gp_db_fail(gp_db *db, const char *what);
 
-/* BEGIN IMMEDIATE, COMMIT (rolls back when it fails), ROLLBACK (only inside a
- * transaction); the first two return 0 or a class of gp_db_fail. */
-int gp_db_begin(gp_db *db);
-int gp_db_commit(gp_db *db);
-void gp_db_rollback(gp_db *db);
+/* Every write is one transaction made with these three:
+ *
+ *     int rc;
+ *     sqlite3_stmt *s = gp_db_write(db, ST_X, &rc);
+ *     if (!s)
+ *         return rc;
+ *     ...bind s...
+ *     return gp_db_end(db, gp_db_run(db, s, "what it does"));
+ *
+ * gp_db_write: statement `id` ready to bind (as gp_db_stmt) with a BEGIN IMMEDIATE
+ * transaction open; NULL with *rc a class of gp_db_fail, and no transaction open, when
+ * either fails. Other statements may run in the transaction (gp_db_stmt, gp_db_run). */
+sqlite3_stmt *gp_db_write(gp_db *db, enum stmt_id id, int *rc);
+
+/* Steps s once and resets it: 0 (a row or done), or a class of gp_db_fail logged with
+ * `what`. gp_db_run_one is for an UPDATE of one row: GP_SRV_ESTATE when it changed none
+ * (the row is not in the state the WHERE asks for). */
+int gp_db_run(gp_db *db, sqlite3_stmt *s, const char *what);
+int gp_db_run_one(gp_db *db, sqlite3_stmt *s, const char *what);
+
+/* Ends the transaction of gp_db_write: rc 0 commits (0, or the commit's failure class,
+ * rolled back), any other rc rolls back. Returns the outcome. */
+int gp_db_end(gp_db *db, int rc);
 
 /* Copies the text of column col (empty when NULL) into dst, truncated to size. */
 void gp_db_copy_text(char *dst, size_t size, sqlite3_stmt *s, int col);

@@ -90,8 +90,9 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
     snprintf(out->updated, sizeof out->updated, "%s", out->created);
     snprintf(out->message, sizeof out->message, "queued");
     out->status = GP_JOB_ACCEPTED;
-    int rc = gp_db_begin(db);
-    if (rc)
+    int rc;
+    sqlite3_stmt *s = gp_db_write(db, ST_INSERT, &rc);
+    if (!s)
         return rc;
     /* the count and the insert in one transaction: two submissions of one key cannot
      * both see room for one more */
@@ -100,15 +101,8 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
             rc = GP_SRV_ELIMIT;
         if (active)
             *active = n_active;
-        if (rc) {
-            gp_db_rollback(db);
-            return rc;
-        }
-    }
-    sqlite3_stmt *s = gp_db_stmt(db, ST_INSERT);
-    if (!s) {
-        gp_db_rollback(db);
-        return GP_SRV_EDB;
+        if (rc)
+            return gp_db_end(db, rc);
     }
     sqlite3_bind_text(s, 1, out->id, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 2, out->created, -1, SQLITE_STATIC);
@@ -121,15 +115,12 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
     sqlite3_bind_int64(s, 9, (sqlite3_int64)spec->seed);
     sqlite3_bind_double(s, 10, spec->expected_disks);
     sqlite3_bind_text(s, 11, owner, -1, SQLITE_STATIC);
-    if (sqlite3_step(s) != SQLITE_ROW) {
+    if (sqlite3_step(s) == SQLITE_ROW)
+        out->seq = sqlite3_column_int64(s, 0);
+    else
         rc = gp_db_fail(db, "insert job");
-        sqlite3_reset(s);
-        gp_db_rollback(db);
-        return rc;
-    }
-    out->seq = sqlite3_column_int64(s, 0);
     sqlite3_reset(s);
-    return gp_db_commit(db);
+    return gp_db_end(db, rc);
 }
 
 int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
@@ -178,14 +169,12 @@ int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t 
     *spec_len = 0;
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
-    sqlite3_stmt *s = gp_db_stmt(db, ST_CLAIM);
+    int result;
+    sqlite3_stmt *s = gp_db_write(db, ST_CLAIM, &result);
     if (!s)
-        return GP_SRV_EDB;
-    int began = gp_db_begin(db);
-    if (began)
-        return began;
+        return result;
     sqlite3_bind_text(s, 1, now, -1, SQLITE_STATIC);
-    int rc = sqlite3_step(s), result = 0;
+    int rc = sqlite3_step(s);
     if (rc == SQLITE_ROW) {
         gp_db_copy_text(id, GP_JOB_ID_SIZE, s, 0);
         int len = sqlite3_column_bytes(s, 1);
@@ -205,11 +194,7 @@ int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t 
     if (rc != SQLITE_DONE && rc != SQLITE_ROW)
         result = gp_db_fail(db, "claim");
     sqlite3_reset(s);
-    if (result == 0) {
-        result = gp_db_commit(db);
-    } else {
-        gp_db_rollback(db);
-    }
+    result = gp_db_end(db, result);
     if (result && result != GP_SRV_ENOTFOUND) {
         free(*spec_text);
         *spec_text = NULL;
@@ -221,22 +206,15 @@ int gp_store_progress(gp_db *db, const char *id, int percent, const char *messag
 {
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
-    sqlite3_stmt *s = gp_db_stmt(db, ST_PROGRESS);
+    int rc;
+    sqlite3_stmt *s = gp_db_write(db, ST_PROGRESS, &rc);
     if (!s)
-        return GP_SRV_EDB;
+        return rc;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
     sqlite3_bind_int(s, 2, percent);
     sqlite3_bind_text(s, 3, message, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 4, now, -1, SQLITE_STATIC);
-    int rc = gp_db_begin(db);
-    if (rc)
-        return rc;
-    if (gp_db_step(s)) {
-        rc = gp_db_fail(db, "progress");
-        gp_db_rollback(db);
-        return rc;
-    }
-    return gp_db_commit(db);
+    return gp_db_end(db, gp_db_run(db, s, "progress"));
 }
 
 /* Runs a one-row UPDATE `id` with (id, text, now) bindings in its own transaction;
@@ -246,12 +224,10 @@ static int update_running(gp_db *db, enum stmt_id which, const char *id, const c
 {
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
-    sqlite3_stmt *s = gp_db_stmt(db, which);
+    int rc;
+    sqlite3_stmt *s = gp_db_write(db, which, &rc);
     if (!s)
-        return GP_SRV_EDB;
-    int began = gp_db_begin(db);
-    if (began)
-        return began;
+        return rc;
     int n = 1;
     sqlite3_bind_text(s, n++, id, -1, SQLITE_STATIC);
     if (a)
@@ -259,14 +235,7 @@ static int update_running(gp_db *db, enum stmt_id which, const char *id, const c
     if (b)
         sqlite3_bind_text(s, n++, b, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, n, now, -1, SQLITE_STATIC);
-    int rc = gp_db_step(s) ? gp_db_fail(db, what) : 0;
-    if (rc == 0 && sqlite3_changes(db->conn) == 0)
-        rc = GP_SRV_ESTATE;
-    if (rc) {
-        gp_db_rollback(db);
-        return rc;
-    }
-    return gp_db_commit(db);
+    return gp_db_end(db, gp_db_run_one(db, s, what));
 }
 
 int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message)
@@ -283,15 +252,13 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
                      int *deleted, gp_job *after)
 {
     *deleted = 0;
-    sqlite3_stmt *s = gp_db_stmt(db, ST_STATUS);
+    int result;
+    sqlite3_stmt *s = gp_db_write(db, ST_STATUS, &result);
     if (!s)
-        return GP_SRV_EDB;
-    int began = gp_db_begin(db);
-    if (began)
-        return began;
+        return result;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
     gp_db_bind_owner(s, 2, owner);
-    int rc = sqlite3_step(s), result = 0;
+    int rc = sqlite3_step(s);
     gp_job_status st = GP_JOB_FAILED;
     if (rc == SQLITE_ROW)
         gp_job_status_parse((const char *)sqlite3_column_text(s, 0), &st);
@@ -311,8 +278,7 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
             sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
             sqlite3_bind_text(s, 2, "dismissed by request", -1, SQLITE_STATIC);
             sqlite3_bind_text(s, 3, now, -1, SQLITE_STATIC);
-            if (gp_db_step(s))
-                result = gp_db_fail(db, "dismiss");
+            result = gp_db_run(db, s, "dismiss");
         }
         if (result == 0)
             gp_store_get_job(db, id, NULL, after);
@@ -321,17 +287,13 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
             result = GP_SRV_EDB;
         } else {
             sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
-            if (gp_db_step(s))
-                result = gp_db_fail(db, "delete");
+            result = gp_db_run(db, s, "delete");
         }
         *deleted = 1;
     }
-    if (result) {
-        gp_db_rollback(db);
-        return result;
-    }
-    *before = st;
-    return gp_db_commit(db);
+    if (result == 0)
+        *before = st;
+    return gp_db_end(db, result);
 }
 
 int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS])

@@ -31,8 +31,7 @@ static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
         sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
         sqlite3_bind_int64(s, 2, (sqlite3_int64)p->count);
         sqlite3_bind_blob64(s, 3, blob, bytes, SQLITE_STATIC);
-        if (gp_db_step(s))
-            rc = gp_db_fail(db, "insert result");
+        rc = gp_db_run(db, s, "insert result");
     }
     free(blob);
     for (size_t i = 0; rc == 0 && i < st->nbins; i++) {
@@ -47,8 +46,7 @@ static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
         sqlite3_bind_double(s, 6, b->achieved);
         sqlite3_bind_int64(s, 7, (sqlite3_int64)b->count);
         sqlite3_bind_double(s, 8, b->z);
-        if (gp_db_step(s))
-            rc = gp_db_fail(db, "insert bin statistics");
+        rc = gp_db_run(db, s, "insert bin statistics");
     }
     for (int i = 0; rc == 0 && i < result->ntimings; i++) {
         if (!(s = gp_db_stmt(db, ST_TIMING)))
@@ -57,8 +55,7 @@ static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
         sqlite3_bind_int(s, 2, i);
         sqlite3_bind_text(s, 3, result->timings[i].stage, -1, SQLITE_STATIC);
         sqlite3_bind_double(s, 4, result->timings[i].seconds);
-        if (gp_db_step(s))
-            rc = gp_db_fail(db, "insert stage timing");
+        rc = gp_db_run(db, s, "insert stage timing");
     }
     return rc;
 }
@@ -71,12 +68,10 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     gp_timestamp_now(now);
     snprintf(message, sizeof message, "%zu disks, packing density %.4f", st->count,
              st->packing_density);
-    sqlite3_stmt *s = gp_db_stmt(db, ST_FINISH);
+    int rc;
+    sqlite3_stmt *s = gp_db_write(db, ST_FINISH, &rc);
     if (!s)
-        return GP_SRV_EDB;
-    int began = gp_db_begin(db);
-    if (began)
-        return began;
+        return rc;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 2, message, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 3, now, -1, SQLITE_STATIC);
@@ -96,16 +91,10 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     sqlite3_bind_int64(s, 17, (sqlite3_int64)p->frozen);
     sqlite3_bind_int64(s, 18, (sqlite3_int64)p->capped);
     sqlite3_bind_int64(s, 19, (sqlite3_int64)p->max_level);
-    int rc = gp_db_step(s) ? gp_db_fail(db, "finish job") : 0;
-    if (rc == 0 && sqlite3_changes(db->conn) == 0)
-        rc = GP_SRV_ESTATE; /* dismissed while it ran: keep nothing */
+    rc = gp_db_run_one(db, s, "finish job"); /* GP_SRV_ESTATE: dismissed while it ran */
     if (rc == 0)
         rc = write_result_rows(db, id, result);
-    if (rc) {
-        gp_db_rollback(db);
-        return rc;
-    }
-    return gp_db_commit(db);
+    return gp_db_end(db, rc); /* nothing kept unless all of it is */
 }
 
 int gp_store_load_result(gp_db *db, const char *id, const char *owner, char **spec_text,

@@ -15,7 +15,7 @@
 #define MAX_SLEEP_SECONDS 1.0
 
 struct gp_waiter {
-    struct MHD_Connection *conn;
+    void *conn;
     char job_id[GP_JOB_ID_SIZE];
     double deadline;
     int suspended; /* the connection is suspended: whoever releases the entry resumes it */
@@ -27,6 +27,7 @@ struct gp_waiters {
     pthread_mutex_t lock; /* guards head, stopping; held around suspend/resume */
     pthread_cond_t changed;
     gp_waiter *head;
+    const gp_suspender *how;
     int stopping;
     pthread_t thread;
 };
@@ -43,7 +44,7 @@ static void release(gp_waiters *w, gp_waiter *e)
         }
     }
     if (e->suspended)
-        MHD_resume_connection(e->conn);
+        w->how->resume(e->conn);
     free(e);
 }
 
@@ -75,11 +76,12 @@ static void *deadline_thread(void *arg)
     return NULL;
 }
 
-int gp_waiters_start(gp_waiters **out)
+int gp_waiters_start(gp_waiters **out, const gp_suspender *how)
 {
     gp_waiters *w = calloc(1, sizeof *w);
     if (!w)
         return GP_ENOMEM;
+    w->how = how;
     pthread_mutex_init(&w->lock, NULL);
     pthread_cond_init(&w->changed, NULL);
     if (pthread_create(&w->thread, NULL, deadline_thread, w)) {
@@ -130,8 +132,7 @@ void gp_waiters_free(gp_waiters *w)
     free(w);
 }
 
-gp_waiter *gp_waiters_add(gp_waiters *w, struct MHD_Connection *conn, const char *job_id,
-                          double deadline)
+gp_waiter *gp_waiters_add(gp_waiters *w, void *conn, const char *job_id, double deadline)
 {
     gp_waiter *e = calloc(1, sizeof *e);
     if (!e)
@@ -156,7 +157,7 @@ int gp_waiters_suspend(gp_waiters *w, gp_waiter *entry)
     pthread_mutex_lock(&w->lock);
     int suspend = !entry->woken && !w->stopping;
     if (suspend) {
-        MHD_suspend_connection(entry->conn);
+        w->how->suspend(entry->conn);
         entry->suspended = 1;
         pthread_cond_signal(&w->changed); /* the deadline thread may need to wake sooner */
     } else {

@@ -1,19 +1,25 @@
 /* waiters.h - the long-poll of GET /jobs/{id}?wait=N: a request that must wait for a job
- * to finish is suspended (libmicrohttpd suspend/resume, so no HTTP thread is held) and
- * resumed when the job reaches a final status or its deadline passes.
+ * to finish is suspended (by the HTTP side: libmicrohttpd's suspend/resume, so no HTTP
+ * thread is held) and resumed when the job reaches a final status or its deadline passes.
  *
  * Locking: one mutex guards the list; suspend and resume calls are made under it so that
  * a connection is never resumed before it was suspended. */
 #ifndef GRAINPACKD_WAITERS_H
 #define GRAINPACKD_WAITERS_H
 
-#include <microhttpd.h>
-
 typedef struct gp_waiters gp_waiters;
 typedef struct gp_waiter gp_waiter; /* one waiting request; owned by the registry */
 
-/* Starts the registry and its deadline thread. Returns 0 or GP_ENOMEM. */
-int gp_waiters_start(gp_waiters **out);
+/* How the HTTP side holds a waiting request's connection (gp_request.conn) and lets it go
+ * on: http.c's gp_http_suspender. */
+typedef struct gp_suspender {
+    void (*suspend)(void *conn);
+    void (*resume)(void *conn);
+} gp_suspender;
+
+/* Starts the registry and its deadline thread; `how` (not copied) must outlive it.
+ * Returns 0 or GP_ENOMEM. */
+int gp_waiters_start(gp_waiters **out, const gp_suspender *how);
 
 /* Resumes every waiting request (they answer with the job as it is), refuses new waits
  * and stops the thread. Call before stopping the HTTP daemon; gp_waiters_free after. */
@@ -23,8 +29,7 @@ void gp_waiters_free(gp_waiters *w);
 /* Registers a request for job_id until `deadline` (monotonic seconds). Returns the entry
  * or NULL when out of memory or stopping. The caller then checks the job and either
  * calls gp_waiters_cancel (it is already final) or gp_waiters_suspend. */
-gp_waiter *gp_waiters_add(gp_waiters *w, struct MHD_Connection *conn, const char *job_id,
-                          double deadline);
+gp_waiter *gp_waiters_add(gp_waiters *w, void *conn, const char *job_id, double deadline);
 
 /* Suspends the connection unless the entry was woken meanwhile (or the registry is
  * stopping). Returns 1 when suspended (the handler returns and is called again once

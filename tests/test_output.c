@@ -2,6 +2,7 @@
  * JSON parsed, SVG counted), and determinism: same seed, same bytes; other seed, other
  * bytes. */
 #include <jansson.h>
+#include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
@@ -53,6 +54,9 @@ static void test_statistics_of_a_hand_made_packing(void)
     CHECK(st.bins[0].count == 3);
     CHECK_NEAR(st.chi2, 1.0, 1e-15);
     CHECK_NEAR(st.bins[0].z, 1.0, 1e-12);
+    /* the standard error of a frequency of 1/2 out of 4 draws: sqrt(0.5 * 0.5 / 4) */
+    CHECK_NEAR(st.bins[0].se, 0.25, 1e-15);
+    CHECK_NEAR(st.bins[1].se, 0.25, 1e-15);
     CHECK_NEAR(st.p_value, gp_chi2_upper_tail(1.0, 1), 1e-15);
     gp_pack_stats_free(&st);
 }
@@ -128,8 +132,16 @@ static void test_json_has_the_disks_and_every_statistic(void)
     json_t *bins = json_object_get(json_object_get(st, "distribution"), "bins");
     CHECK(json_array_size(bins) == 12);
     json_int_t total = 0;
-    for (size_t i = 0; i < json_array_size(bins); i++)
-        total += json_integer_value(json_object_get(json_array_get(bins, i), "count"));
+    for (size_t i = 0; i < json_array_size(bins); i++) {
+        json_t *bin = json_array_get(bins, i);
+        total += json_integer_value(json_object_get(bin, "count"));
+        /* the error bar of each bin is its standard error, the unit of its z */
+        double t = json_real_value(json_object_get(bin, "target"));
+        double se = json_real_value(json_object_get(bin, "se"));
+        CHECK_NEAR(se, sqrt(t * (1.0 - t) / (double)r.packing.count), 1e-15);
+        CHECK_NEAR(json_real_value(json_object_get(bin, "z")) * se,
+                   json_real_value(json_object_get(bin, "achieved")) - t, 1e-12);
+    }
     CHECK(total == (json_int_t)r.packing.count);
     CHECK(json_object_get(st, "front") != NULL && json_object_get(json_object_get(st, "distribution"), "chi2") != NULL);
     json_t *first = json_array_get(json_object_get(root, "disks"), 0);

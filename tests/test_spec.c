@@ -1,5 +1,6 @@
 /* test_spec.c - the job spec: both accepted shapes, defaults, and every error path with
  * its JSON pointer and message. */
+#include <jansson.h>
 #include <stdlib.h>
 
 #include "check.h"
@@ -231,6 +232,75 @@ static void test_example_files_load(void)
     CHECK(strstr(err.message, "/nonexistent/spec.json") != NULL);
 }
 
+/* Whether two parsed specs are the same job: every field the stages read. */
+static int same_spec(const gp_spec *a, const gp_spec *b)
+{
+    int same = a->domain.width == b->domain.width && a->domain.height == b->domain.height &&
+               a->dist.kind == b->dist.kind && a->dist.radius == b->dist.radius &&
+               a->dist.min == b->dist.min && a->dist.max == b->dist.max &&
+               a->dist.nbins == b->dist.nbins && a->joint.law == b->joint.law &&
+               a->joint.value == b->joint.value && a->joint.k == b->joint.k &&
+               a->joint.exponent == b->joint.exponent && a->seed == b->seed &&
+               a->level_band == b->level_band && a->expected_disks == b->expected_disks &&
+               a->balance_enabled == b->balance_enabled &&
+               a->balance.method == b->balance.method &&
+               a->balance.max_iterations == b->balance.max_iterations &&
+               a->balance.max_step == b->balance.max_step &&
+               a->laguerre_enabled == b->laguerre_enabled &&
+               a->laguerre.shrink == b->laguerre.shrink &&
+               a->laguerre.flush_boundary == b->laguerre.flush_boundary &&
+               a->picture_color == b->picture_color && a->picture_disks == b->picture_disks;
+    for (size_t i = 0; same && i < a->dist.nbins; i++)
+        same = a->dist.bins[i].min == b->dist.bins[i].min &&
+               a->dist.bins[i].max == b->dist.bins[i].max && a->dist.bins[i].p == b->dist.bins[i].p;
+    return same;
+}
+
+static void test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit(void)
+{
+    static const char *const specs[] = {
+        "{\"inputs\":{\"domain\":{\"width\":237,\"height\":300},\"distribution\":{\"kind\":"
+        "\"histogram\",\"bins\":" IRON_BINS "},\"joint\":{\"law\":\"inverse\",\"k\":2.0}}}",
+        "{" DOM "," CONST "}",
+        "{\"domain\":{\"width\":10.1,\"height\":0.7e1},\"distribution\":{\"kind\":\"uniform\","
+        "\"min\":0.1,\"max\":0.3},\"joint\":{\"law\":\"power\",\"k\":0.1,\"exponent\":-0.5},"
+        "\"front\":{\"level_band\":3},\"seed\":9223372036854775807}",
+        "{" DOM "," CONST ",\"joint\":{\"law\":\"constant\",\"value\":0.1},\"balance\":"
+        "{\"method\":\"laplacian\",\"max_iterations\":7,\"max_step\":0.3},\"laguerre\":"
+        "{\"shrink\":\"offset\",\"flush_boundary\":true},\"picture\":{\"color\":\"radius\","
+        "\"disks\":true}}",
+        "{" DOM "," CONST ",\"balance\":{\"method\":\"relocation\"},\"laguerre\":{\"shrink\":"
+        "\"homothetic\"}}",
+    };
+    for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++) {
+        gp_spec a, b;
+        gp_error err;
+        CHECK_MSG(parse(specs[i], &a, &err) == 0, "case %zu: %s %s", i, err.pointer, err.message);
+        json_t *first = gp_spec_json(&a);
+        CHECK(first != NULL);
+        char *text = json_dumps(first, JSON_COMPACT);
+        CHECK_MSG(parse(text, &b, &err) == 0, "case %zu: %s does not parse: %s %s", i, text,
+                  err.pointer, err.message);
+        CHECK_MSG(same_spec(&a, &b), "case %zu: %s is another spec", i, text);
+        json_t *second = gp_spec_json(&b);
+        CHECK_MSG(json_equal(first, second), "case %zu: not a fixed point", i);
+        /* the defaults are written out: a reader sees what the job will do */
+        CHECK(json_integer_value(json_object_get(first, "seed")) == (json_int_t)a.seed);
+        CHECK(json_object_get(json_object_get(first, "joint"), "law") != NULL);
+        CHECK(json_object_get(json_object_get(first, "front"), "level_band") != NULL);
+        CHECK(json_object_get(json_object_get(first, "picture"), "color") != NULL);
+        CHECK((json_object_get(first, "balance") != NULL) == a.balance_enabled);
+        if (a.balance_enabled)
+            CHECK(json_integer_value(json_object_get(json_object_get(first, "balance"),
+                                                     "max_iterations")) == a.balance.max_iterations);
+        free(text);
+        json_decref(first);
+        json_decref(second);
+        gp_spec_free(&a);
+        gp_spec_free(&b);
+    }
+}
+
 int main(void)
 {
     RUN(test_whole_request_and_bare_inputs_both_parse);
@@ -241,5 +311,6 @@ int main(void)
     RUN(test_keys_are_escaped_in_pointers);
     RUN(test_caps_are_configurable);
     RUN(test_example_files_load);
+    RUN(test_spec_json_reads_back_as_the_same_spec_with_defaults_explicit);
     return check_status();
 }

@@ -74,6 +74,11 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
 double gp_spec_expected_disks(const gp_domain *domain, const gp_distribution *dist,
                               const gp_joint *joint);
 
+/* The spec as JSON inputs, every default made explicit (seed, joint, front, the stages'
+ * options, picture): parsed again it gives the same spec. Returns a new jansson
+ * json_t reference the caller owns, or NULL when out of memory. */
+struct json_t *gp_spec_json(const gp_spec *spec);
+
 /* Frees what the spec owns and zeroes it. */
 void gp_spec_free(gp_spec *spec);
 

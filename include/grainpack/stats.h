@@ -19,7 +19,9 @@ typedef struct gp_bin_stat {
     double target;    /* probability asked for */
     size_t count;     /* disks whose grain radius falls in the bin */
     double achieved;  /* count / number of disks */
-    double z;         /* (achieved - target) / sqrt(target (1 - target) / n); 0 if undefined */
+    double se;        /* standard error of `achieved` when the law holds: sqrt(target (1 - target) / n),
+                         0 without disks (the error bar of a plot) */
+    double z;         /* (achieved - target) / se; 0 if undefined */
 } gp_bin_stat;
 
 typedef struct gp_pack_stats {
@@ -80,7 +82,7 @@ int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **bins, size_t *n
 /* The bin holding r among bins sorted by min, or -1 when r lies in none of them. */
 long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
 
-/* Fills `achieved` and `z` of every bin from its count out of n values, and *max_abs_z. */
+/* Fills `achieved`, `se` and `z` of every bin from its count out of n values, and *max_abs_z. */
 void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
 
 /* The upper tail P(X >= x) of a chi-square law with dof degrees of freedom (dof >= 1). */

@@ -183,7 +183,7 @@ static void setup(void)
     if (gp_store_open(cfg.db_path, &svc.store, NULL, why, sizeof why) ||
         gp_keyring_load(cfg.key_file, &svc.keys, why, sizeof why) ||
         !(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
-        gp_waiters_start(&svc.waiters) || gp_http_start_embedded(&svc, &daemon_)) {
+        gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_http_start_embedded(&svc, &daemon_)) {
         fprintf(stderr, "fuzz_http: cannot set up the service: %s\n", why);
         abort();
     }

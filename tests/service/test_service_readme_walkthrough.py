@@ -37,6 +37,7 @@ def test(c, binary):
             svg = open(os.path.join(work, "bagi.svg")).read() if os.path.exists(os.path.join(work, "bagi.svg")) else ""
             c.check(svg.rstrip().endswith("</svg>"), "bagi.svg is not a whole SVG")
         for expected in ['"conformsTo"', '"id":"pack2d"', "job at http://", '"status":"successful"',
+                         "<!doctype html>", '"valid":true,"expected_disks":',
                          "x,y,r,R", '"packing_density"', '"timings"', '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
                          'grainpack_jobs{status="successful"}', "openapi: 3.1.0"]:

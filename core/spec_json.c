@@ -1,0 +1,84 @@
+/* spec_json.c - a parsed job spec written back as JSON, with every default made
+ * explicit: what the validator understood, for a client to show or to submit as it is. */
+#include <jansson.h>
+
+#include "grainpack/spec.h"
+
+/* json_object_set_new that remembers a failure instead of returning it at every call. */
+static void put(json_t *obj, const char *key, json_t *value, int *failed)
+{
+    if (!obj) {
+        json_decref(value);
+        *failed = 1;
+    } else if (!value || json_object_set_new(obj, key, value)) {
+        *failed = 1;
+    }
+}
+
+static json_t *distribution_json(const gp_distribution *d, int *failed)
+{
+    json_t *o = json_object();
+    switch (d->kind) {
+    case GP_DIST_CONSTANT:
+        put(o, "kind", json_string("constant"), failed);
+        put(o, "radius", json_real(d->radius), failed);
+        break;
+    case GP_DIST_UNIFORM:
+        put(o, "kind", json_string("uniform"), failed);
+        put(o, "min", json_real(d->min), failed);
+        put(o, "max", json_real(d->max), failed);
+        break;
+    case GP_DIST_HISTOGRAM: {
+        json_t *bins = json_array();
+        for (size_t i = 0; bins && i < d->nbins; i++)
+            if (json_array_append_new(bins, json_pack("{s:f, s:f, s:f}", "min", d->bins[i].min,
+                                                      "max", d->bins[i].max, "p", d->bins[i].p)))
+                *failed = 1;
+        put(o, "kind", json_string("histogram"), failed);
+        put(o, "bins", bins, failed);
+        break;
+    }
+    }
+    return o;
+}
+
+static json_t *joint_json(const gp_joint *j, int *failed)
+{
+    json_t *o = json_object();
+    put(o, "law", json_string(gp_joint_law_name(j->law)), failed);
+    if (j->law == GP_JOINT_CONSTANT)
+        put(o, "value", json_real(j->value), failed);
+    if (j->law == GP_JOINT_INVERSE || j->law == GP_JOINT_POWER)
+        put(o, "k", json_real(j->k), failed);
+    if (j->law == GP_JOINT_POWER)
+        put(o, "exponent", json_real(j->exponent), failed);
+    return o;
+}
+
+json_t *gp_spec_json(const gp_spec *spec)
+{
+    int failed = 0;
+    json_t *in = json_object();
+    put(in, "domain", json_pack("{s:f, s:f}", "width", spec->domain.width, "height",
+                                spec->domain.height), &failed);
+    put(in, "distribution", distribution_json(&spec->dist, &failed), &failed);
+    put(in, "joint", joint_json(&spec->joint, &failed), &failed);
+    put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
+    put(in, "front", json_pack("{s:i}", "level_band", (int)spec->level_band), &failed);
+    if (spec->balance_enabled)
+        put(in, "balance", json_pack("{s:s, s:i, s:f}", "method",
+                                     gp_balance_method_name(spec->balance.method), "max_iterations",
+                                     (int)spec->balance.max_iterations, "max_step",
+                                     spec->balance.max_step), &failed);
+    if (spec->laguerre_enabled)
+        put(in, "laguerre", json_pack("{s:s, s:b}", "shrink", gp_shrink_name(spec->laguerre.shrink),
+                                      "flush_boundary", spec->laguerre.flush_boundary), &failed);
+    put(in, "picture", json_pack("{s:s, s:b}", "color",
+                                 spec->picture_color == GP_PICTURE_COLOR_QUALITY ? "quality" : "radius",
+                                 "disks", spec->picture_disks), &failed);
+    if (failed) {
+        json_decref(in);
+        return NULL;
+    }
+    return in;
+}
