@@ -91,7 +91,7 @@ static balanced balance_copy(const gp_spec *spec, const gp_packing *pk, gp_balan
     memcpy(d, pk->disks, pk->count * sizeof *d);
     gp_error err;
     gp_rt *rt;
-    if (gp_rt_build(d, pk->count, &rt, &err))
+    if (gp_rt_build(d, pk->count, NULL, &rt, &err))
         die("triangulation", &err);
     gp_balance_params params = {method, cap, max_step, update};
     double t0 = now();
@@ -192,7 +192,7 @@ static void work_build(const gp_spec *spec, const gp_packing *pk, const void *ct
     gp_error err;
     gp_rt *rt;
     double t0 = now();
-    if (gp_rt_build(pk->disks, pk->count, &rt, &err))
+    if (gp_rt_build(pk->disks, pk->count, NULL, &rt, &err))
         die("triangulation", &err);
     out[0] = now() - t0;
     gp_rt_free(rt);
@@ -205,7 +205,7 @@ static void work_laguerre(const gp_spec *spec, const gp_packing *pk, const void 
     gp_error err;
     gp_rt *rt;
     double t0 = now();
-    if (gp_rt_build(pk->disks, pk->count, &rt, &err))
+    if (gp_rt_build(pk->disks, pk->count, NULL, &rt, &err))
         die("triangulation", &err);
     out[0] = now() - t0;
     gp_laguerre_params params = {GP_SHRINK_OFFSET, 0};

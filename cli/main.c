@@ -109,7 +109,11 @@ static int run(const char *spec_path, gp_format format, const char *out_path, si
         fprintf(stderr, "grainpack: cannot write %s: %s\n", out_path, strerror(errno));
         status = EXIT_FAILED;
     } else {
-        rc = gp_write_result(out, format, &spec, &result);
+        gp_out sink;
+        rc = gp_out_init_file(&sink, out);
+        if (rc == 0)
+            rc = gp_write_result(&sink, format, &spec, &result);
+        gp_out_free(&sink);
         if (out_path && fclose(out) != 0)
             rc = GP_EIO;
         else if (!out_path && fflush(out) != 0)

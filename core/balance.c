@@ -20,7 +20,7 @@
 #define STEP_DECREMENT 0.05
 
 /* Centres between two progress reports and cancel checks: a few milliseconds of work. */
-#define CENTRES_PER_REPORT 16384
+#define CENTRES_PER_REPORT GP_QUALITY_CENTRES_PER_CHECK
 
 /* The box of the positions a centre tries is widened by this fraction of its radius, so
  * that the positions on the way to its target, which rounding can put a few ulps outside
@@ -177,7 +177,7 @@ static int report(const gp_progress *progress, double fraction, gp_error *err)
 {
     if (!progress)
         return 0;
-    if (progress->cancel && atomic_load_explicit(progress->cancel, memory_order_relaxed))
+    if (gp_canceled(progress->cancel))
         return gp_error_set(err, GP_ECANCELED, NULL, "balancing canceled");
     if (progress->report)
         progress->report(progress->ctx, "balance", fraction);
@@ -213,10 +213,15 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
 }
 
 /* Measures F again where it is stale or where the last update changed the ring, then
- * the whole structure into *stats. */
-static void measure(balancer *b, int histogram, gp_quality_stats *stats)
+ * the whole structure into *stats. Reads *cancel (may be NULL) as gp_quality does, every
+ * GP_QUALITY_CENTRES_PER_CHECK centres: before the sweeps every centre is measured. Returns
+ * 0 or GP_ECANCELED with err. */
+static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp_cancel_flag *cancel,
+                   gp_error *err)
 {
     for (size_t i = 0; i < b->n; i++) {
+        if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel))
+            return gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
         if (!b->stale[i] && !b->changed[i])
             continue;
         size_t degree;
@@ -225,6 +230,14 @@ static void measure(balancer *b, int histogram, gp_quality_stats *stats)
         b->stale[i] = b->changed[i] = 0;
     }
     quality_summarise(b->F, b->n, histogram, stats);
+    return 0;
+}
+
+/* The error of a rings_init or rings_refresh that returned rc. */
+static int rings_failed(int rc, size_t n, gp_error *err)
+{
+    return rc == GP_ECANCELED ? gp_error_set(err, rc, NULL, "balancing canceled")
+                              : gp_error_set(err, rc, NULL, "out of memory for the rings of %zu disks", n);
 }
 
 /* Brings the triangulation, the rings and F up to date after the centres in b->moved
@@ -232,8 +245,10 @@ static void measure(balancer *b, int histogram, gp_quality_stats *stats)
  * have changed: at the centres that moved, at their neighbours (their gaps changed),
  * and at every centre whose ring the update changed. */
 static int follow_moves(balancer *b, gp_rt *rt, gp_rt_update update, gp_rt_update_stats *counts,
-                        int histogram, gp_quality_stats *stats, gp_error *err)
+                        int histogram, const gp_progress *progress, gp_quality_stats *stats,
+                        gp_error *err)
 {
+    const gp_cancel_flag *cancel = gp_progress_cancel(progress);
     for (size_t m = 0; m < b->nmoved; m++) {
         size_t degree;
         const int32_t *ring = rings_of(&b->rings, b->moved[m], &degree);
@@ -241,13 +256,12 @@ static int follow_moves(balancer *b, gp_rt *rt, gp_rt_update update, gp_rt_updat
         for (size_t k = 0; k < degree; k++)
             b->stale[ring[k]] = 1;
     }
-    int rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, update, counts, err);
+    int rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, update, counts, progress, err);
     if (rc)
         return rc;
-    if (rings_refresh(&b->rings, rt, b->changed))
-        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the rings of %zu disks", b->n);
-    measure(b, histogram, stats);
-    return 0;
+    if ((rc = rings_refresh(&b->rings, rt, b->changed, cancel)))
+        return rings_failed(rc, b->n, err);
+    return measure(b, histogram, stats, cancel, err);
 }
 
 /* Whether structure `a` is better than `best`: a lower F_max (the report's figure),
@@ -302,19 +316,20 @@ static double largest_radius(const gp_disk *disks, size_t n)
     return R_max;
 }
 
-/* Sets up what the sweeps work with and measures F before them into out->before. */
-static int start_sweeps(balancer *b, gp_rt *rt, gp_balance_result *out, gp_error *err)
+/* Sets up what the sweeps work with and measures F before them into out->before; reads
+ * the cancel flag of `progress` (may be NULL) while it walks the rings and measures F. */
+static int start_sweeps(balancer *b, gp_rt *rt, const gp_progress *progress, gp_balance_result *out,
+                        gp_error *err)
 {
     int rc = nearby_init(&b->near, b->domain, b->disks, b->n, largest_radius(b->disks, b->n));
     if (rc)
         return gp_error_set(err, rc, NULL, rc == GP_ETOOBIG ? "the bucket grid would be too large"
                                                            : "out of memory for the bucket grid");
-    if (rings_init(&b->rings, rt, b->n))
-        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the rings of %zu disks", b->n);
+    if ((rc = rings_init(&b->rings, rt, b->n, progress)))
+        return rings_failed(rc, b->n, err);
     gp_rt_mark_changes(rt, b->changed);
     memset(b->stale, 1, b->n);
-    measure(b, 1, &out->before);
-    return 0;
+    return measure(b, 1, &out->before, gp_progress_cancel(progress), err);
 }
 
 /* Sweeps until one moves nothing, the structure is steady, the best structure has not
@@ -324,7 +339,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
                       const gp_progress *progress, gp_balance_result *out, gp_error *err)
 {
     uint32_t cap = params->max_iterations ? params->max_iterations : GP_BALANCE_DEFAULT_MAX_ITERATIONS;
-    int rc = start_sweeps(b, rt, out, err);
+    int rc = start_sweeps(b, rt, progress, out, err);
     if (rc)
         return rc;
     /* `best` is the structure returned; the lowest F_max and the lowest mean seen, even
@@ -347,7 +362,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
             out->stop = GP_BALANCE_STOP_CONVERGED;
             break;
         }
-        if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 0, &now, err)) ||
+        if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 0, progress, &now, err)) ||
             (rc = report(progress, share * out->sweeps, err)))
             return rc;
         nearby_sort(&b->near, b->disks);
@@ -374,7 +389,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
         lowest_mean = now.mean < lowest_mean ? now.mean : lowest_mean;
     }
     restore_best(b);
-    if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, &out->after, err)))
+    if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, progress, &out->after, err)))
         return rc;
     return 0;
 }
@@ -403,7 +418,7 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
         goto done;
     }
     if (params->method == GP_BALANCE_NONE || n == 0) {
-        if ((rc = gp_quality(domain, rt, disks, n, out->F, &out->before, err)))
+        if ((rc = gp_quality(domain, rt, disks, n, out->F, &out->before, gp_progress_cancel(progress), err)))
             goto done;
         out->after = out->before;
     } else {

@@ -13,6 +13,8 @@ int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
     memset(out, 0, sizeof *out);
     size_t n = cells->count;
     out->count = n;
+    out->vertices = cells->start[n];
+    out->neighbour_links = cells->nstart[n];
     for (size_t i = 0; i < n; i++) {
         size_t k = cells->nstart[i + 1] - cells->nstart[i];
         out->max_neighbours = k > out->max_neighbours ? k : out->max_neighbours;

@@ -1,12 +1,31 @@
 /* io_csv.c - one line per disk: x,y,r,R (r the grain radius, R = r + j(r)). */
-#include "grainpack/io.h"
+#include "writer.h"
 
-int gp_write_csv(FILE *out, const gp_result *result)
+static void header(gp_writer *w, gp_out *out, int param)
 {
-    fputs("x,y,r,R\n", out);
-    const gp_packing *p = &result->packing;
-    for (size_t i = 0; i < p->count; i++)
-        fprintf(out, "%.17g,%.17g,%.17g,%.17g\n", p->disks[i].x, p->disks[i].y, p->disks[i].r,
-                p->disks[i].R);
-    return ferror(out) ? GP_EIO : 0;
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, "x,y,r,R\n");
+}
+
+static void disk_line(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
+{
+    (void)w;
+    (void)param;
+    const gp_disk *d = &win->disks[j];
+    gp_out_double(out, d->x);
+    gp_out_char(out, ',');
+    gp_out_double(out, d->y);
+    gp_out_char(out, ',');
+    gp_out_double(out, d->r);
+    gp_out_char(out, ',');
+    gp_out_double(out, d->R);
+    gp_out_char(out, '\n');
+}
+
+int gp_plan_csv(gp_writer *w)
+{
+    gp_writer_text(w, header, 0);
+    gp_writer_grains(w, disk_line, GP_GRAINS_DISKS, 0);
+    return 0;
 }

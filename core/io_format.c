@@ -1,16 +1,17 @@
-/* io_format.c - result format names, media types and dispatch. */
+/* io_format.c - result format names and media types. */
 #include <string.h>
 
 #include "grainpack/io.h"
 
 static const struct {
     const char *name, *media_type;
+    int text;
 } formats[] = {
-    [GP_FORMAT_JSON] = {"json", "application/json"},
-    [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8"},
-    [GP_FORMAT_SVG] = {"svg", "image/svg+xml"},
+    [GP_FORMAT_JSON] = {"json", "application/json", 1},
+    [GP_FORMAT_CSV] = {"csv", "text/csv; charset=utf-8", 1},
+    [GP_FORMAT_SVG] = {"svg", "image/svg+xml", 1},
     /* legacy VTK has no registered media type; this is the one in common use */
-    [GP_FORMAT_VTK] = {"vtk", "application/x-vtk"},
+    [GP_FORMAT_VTK] = {"vtk", "application/x-vtk", 1},
 };
 
 int gp_format_parse(const char *name, gp_format *out)
@@ -39,13 +40,7 @@ const char *gp_format_media_type(gp_format format)
     return formats[format].media_type;
 }
 
-int gp_write_result(FILE *out, gp_format format, const gp_spec *spec, const gp_result *result)
+int gp_format_is_text(gp_format format)
 {
-    switch (format) {
-    case GP_FORMAT_JSON: return gp_write_json(out, spec, result);
-    case GP_FORMAT_CSV: return gp_write_csv(out, result);
-    case GP_FORMAT_SVG: return gp_write_svg(out, spec, result);
-    case GP_FORMAT_VTK: return gp_write_vtk(out, spec, result);
-    }
-    return GP_EINVAL;
+    return formats[format].text;
 }

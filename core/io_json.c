@@ -1,7 +1,10 @@
-/* io_json.c - the statistics object and the full JSON result. */
+/* io_json.c - the statistics object, a compact JSON emitter with shortest doubles, and the
+ * full JSON result. */
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "grainpack/io.h"
+#include "writer.h"
 
 /* json_object_set_new that remembers a failure instead of returning it at every call. */
 static void put(json_t *obj, const char *key, json_t *value, int *failed)
@@ -186,53 +189,203 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
     return root;
 }
 
-/* "cells": one object per grain: its id (the index of its disk), centre, radius, polygon
- * (counter-clockwise) and the ids of its neighbours. */
-static void write_cells(FILE *out, const gp_result *result)
+/* A JSON string: quote, backslash and control characters escaped, the rest (UTF-8) as
+ * it is. */
+static void json_string_out(gp_out *out, const char *s, size_t len)
 {
-    const gp_cells *c = &result->cells;
-    const gp_disk *d = result->packing.disks;
-    fputs(",\n\"cells\": [", out);
-    for (size_t i = 0; i < c->count; i++) {
-        fprintf(out, "%s\n{\"id\":%zu,\"x\":%.17g,\"y\":%.17g,\"r\":%.17g,\"area\":%.17g,\"polygon\":[",
-                i ? "," : "", i, d[i].x, d[i].y, d[i].r, c->area[i]);
-        for (size_t k = c->start[i]; k < c->start[i + 1]; k++)
-            fprintf(out, "%s[%.17g,%.17g]", k > c->start[i] ? "," : "", c->xy[2 * k], c->xy[2 * k + 1]);
-        fputs("],\"neighbours\":[", out);
-        for (size_t k = c->nstart[i]; k < c->nstart[i + 1]; k++)
-            fprintf(out, "%s%d", k > c->nstart[i] ? "," : "", c->neighbours[k]);
-        fputs("]}", out);
+    static const char hex[] = "0123456789abcdef";
+    gp_out_char(out, '"');
+    size_t plain = 0;
+    for (size_t i = 0; i < len; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c != '"' && c != '\\')
+            continue;
+        gp_out_write(out, s + plain, i - plain);
+        plain = i + 1;
+        char esc[6] = {'\\', (char)c, 0, 0, 0, 0};
+        size_t n = 2;
+        if (c == '\n')
+            esc[1] = 'n';
+        else if (c == '\t')
+            esc[1] = 't';
+        else if (c == '\r')
+            esc[1] = 'r';
+        else if (c < 0x20) {
+            memcpy(esc + 1, "u00", 3);
+            esc[4] = hex[c >> 4];
+            esc[5] = hex[c & 15];
+            n = 6;
+        }
+        gp_out_write(out, esc, n);
     }
-    fputs("\n]", out);
+    gp_out_write(out, s + plain, len - plain);
+    gp_out_char(out, '"');
 }
 
-int gp_write_json(FILE *out, const gp_spec *spec, const gp_result *result)
+void gp_out_json(gp_out *out, const json_t *value)
 {
-    json_t *stats = gp_statistics_json(spec, result);
-    if (!stats)
-        return GP_ENOMEM;
-    fprintf(out, "{\n\"domain\": {\"width\": %.17g, \"height\": %.17g},\n\"statistics\": ",
-            spec->domain.width, spec->domain.height);
-    int rc = json_dumpf(stats, out, JSON_COMPACT | JSON_REAL_PRECISION(17)) ? GP_EIO : 0;
-    json_decref(stats);
-    fputs(",\n\"disks\": [", out);
-    const gp_packing *p = &result->packing;
-    for (size_t i = 0; i < p->count; i++) {
-        fprintf(out, "%s\n{\"x\":%.17g,\"y\":%.17g,\"r\":%.17g,\"R\":%.17g", i ? "," : "",
-                p->disks[i].x, p->disks[i].y, p->disks[i].r, p->disks[i].R);
-        if (result->has_balance) {
-            /* F is defined for interior centres only (balance.h) */
-            double F = result->balance.F[i];
-            if (isnan(F))
-                fputs(",\"F\":null", out);
-            else
-                fprintf(out, ",\"F\":%.17g", F);
+    switch (json_typeof(value)) {
+    case JSON_OBJECT: {
+        const char *key;
+        json_t *item;
+        int first = 1;
+        gp_out_char(out, '{');
+        json_object_foreach((json_t *)value, key, item) {
+            if (!first)
+                gp_out_char(out, ',');
+            first = 0;
+            json_string_out(out, key, strlen(key));
+            gp_out_char(out, ':');
+            gp_out_json(out, item);
         }
-        fputc('}', out);
+        gp_out_char(out, '}');
+        break;
     }
-    fputs("\n]", out);
-    if (result->has_cells)
-        write_cells(out, result);
-    fputs("\n}\n", out);
-    return rc ? rc : (ferror(out) ? GP_EIO : 0);
+    case JSON_ARRAY:
+        gp_out_char(out, '[');
+        for (size_t i = 0; i < json_array_size(value); i++) {
+            if (i)
+                gp_out_char(out, ',');
+            gp_out_json(out, json_array_get(value, i));
+        }
+        gp_out_char(out, ']');
+        break;
+    case JSON_STRING:
+        json_string_out(out, json_string_value(value), json_string_length(value));
+        break;
+    case JSON_INTEGER: gp_out_int(out, (int64_t)json_integer_value(value)); break;
+    case JSON_REAL: gp_out_double(out, json_real_value(value)); break;
+    case JSON_TRUE: GP_OUT_LITERAL(out, "true"); break;
+    case JSON_FALSE: GP_OUT_LITERAL(out, "false"); break;
+    case JSON_NULL: GP_OUT_LITERAL(out, "null"); break;
+    }
+}
+
+/* What the JSON writer keeps between steps. */
+typedef struct json_state {
+    json_t *statistics; /* built by the plan, so that a failure shows before any byte */
+} json_state;
+
+static void drop_state(void *state)
+{
+    json_decref(((json_state *)state)->statistics);
+}
+
+static void head(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    json_state *st = w->state;
+    GP_OUT_LITERAL(out, "{\n\"domain\": {\"width\": ");
+    gp_out_double(out, w->spec->domain.width);
+    GP_OUT_LITERAL(out, ", \"height\": ");
+    gp_out_double(out, w->spec->domain.height);
+    GP_OUT_LITERAL(out, "},\n\"statistics\": ");
+    gp_out_json(out, st->statistics);
+    json_decref(st->statistics); /* written once: not needed any more */
+    st->statistics = NULL;
+    GP_OUT_LITERAL(out, ",\n\"disks\": [");
+}
+
+/* ,"name":value (the name a literal, with its quotes and colon). */
+#define field(out, name, v) (GP_OUT_LITERAL(out, name), gp_out_double(out, v))
+
+static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
+{
+    (void)param;
+    const gp_disk *d = &win->disks[j];
+    if (win->first + j)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"x\":");
+    gp_out_double(out, d->x);
+    field(out, ",\"y\":", d->y);
+    field(out, ",\"r\":", d->r);
+    field(out, ",\"R\":", d->R);
+    if (w->result->has_balance) {
+        /* F is defined for interior centres only (balance.h) */
+        double F = win->F[j];
+        if (isnan(F))
+            GP_OUT_LITERAL(out, ",\"F\":null");
+        else
+            field(out, ",\"F\":", F);
+    }
+    gp_out_char(out, '}');
+}
+
+static void close_array(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, "\n]");
+}
+
+static void open_cells(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, ",\n\"cells\": [");
+}
+
+/* "cells": one object per grain: its id (the index of its disk), centre, radius, polygon
+ * (counter-clockwise) and the ids of its neighbours. */
+static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
+{
+    (void)w;
+    (void)param;
+    const gp_disk *d = &win->disks[j];
+    size_t id = win->first + j;
+    if (id)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"id\":");
+    gp_out_uint(out, id);
+    field(out, ",\"x\":", d->x);
+    field(out, ",\"y\":", d->y);
+    field(out, ",\"r\":", d->r);
+    field(out, ",\"area\":", win->area[j]);
+    GP_OUT_LITERAL(out, ",\"polygon\":[");
+    for (size_t k = win->start[j]; k < win->start[j + 1]; k++) {
+        const double *v = &win->xy[2 * (k - win->vertex_base)];
+        if (k > win->start[j])
+            gp_out_char(out, ',');
+        gp_out_char(out, '[');
+        gp_out_double(out, v[0]);
+        gp_out_char(out, ',');
+        gp_out_double(out, v[1]);
+        gp_out_char(out, ']');
+    }
+    GP_OUT_LITERAL(out, "],\"neighbours\":[");
+    for (size_t k = win->nstart[j]; k < win->nstart[j + 1]; k++) {
+        if (k > win->nstart[j])
+            gp_out_char(out, ',');
+        gp_out_int(out, win->neighbours[k - win->neighbour_base]);
+    }
+    GP_OUT_LITERAL(out, "]}");
+}
+
+static void tail(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, "\n}\n");
+}
+
+int gp_plan_json(gp_writer *w)
+{
+    json_state *st = calloc(1, sizeof *st);
+    if (!st)
+        return GP_ENOMEM;
+    w->state = st;
+    w->drop = drop_state;
+    if (!(st->statistics = gp_statistics_json(w->spec, w->result)))
+        return GP_ENOMEM;
+    gp_writer_text(w, head, 0);
+    gp_writer_grains(w, disk, GP_GRAINS_DISKS | (w->result->has_balance ? GP_GRAINS_F : 0), 0);
+    gp_writer_text(w, close_array, 0);
+    if (w->result->has_cells) {
+        gp_writer_text(w, open_cells, 0);
+        gp_writer_grains(w, cell,
+                         GP_GRAINS_DISKS | GP_GRAINS_AREA | GP_GRAINS_POLYGONS | GP_GRAINS_NEIGHBOURS, 0);
+        gp_writer_text(w, close_array, 0);
+    }
+    gp_writer_text(w, tail, 0);
+    return 0;
 }

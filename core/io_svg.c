@@ -3,11 +3,12 @@
  * grains are disks with their grain-boundary ring (the joint, from r to R) in dark grey;
  * with cells they are the (shrunk) cells on a dark grey ground, which is the boundary
  * band, optionally with the grain disks outlined. Kept compact for 10^5 grains: one
- * element per grain, grouped by colour class. */
+ * element per grain, grouped by colour class (one pass over the grains per class).
+ * Coordinates are rounded to what a screen shows (see svg_decimals). */
 #include <math.h>
 #include <stdlib.h>
 
-#include "grainpack/io.h"
+#include "writer.h"
 
 /* Colour classes of the scale; more would not be told apart on screen. */
 #define COLOR_CLASSES 16
@@ -49,24 +50,25 @@ static void class_color(int cls, char out[8])
 typedef struct colouring {
     const char *title, *symbol;
     double lo, hi;
-    const double *F; /* NULL when colouring by radius */
+    int by_F; /* 0: by radius */
 } colouring;
 
 static colouring choose_colouring(const gp_spec *spec, const gp_result *result)
 {
-    colouring c = {"grain radius", "r", 0.0, 0.0, NULL};
+    colouring c = {"grain radius", "r", 0.0, 0.0, 0};
     if (spec->picture_color == GP_PICTURE_COLOR_QUALITY && result->has_balance) {
         const gp_balance_result *b = &result->balance;
-        c = (colouring){"balance criterion F", "F", 0.0, b->after_only ? b->after.max : b->before.max, b->F};
+        c = (colouring){"balance criterion F", "F", 0.0, b->after_only ? b->after.max : b->before.max, 1};
         return c;
     }
     gp_distribution_support(&spec->dist, &c.lo, &c.hi);
     return c;
 }
 
-static int grain_class(const colouring *c, const gp_disk *d, size_t i)
+/* The colour class of grain j of a window. */
+static int grain_class(const colouring *c, const gp_grain_window *win, size_t j)
 {
-    double v = c->F ? c->F[i] : d->r;
+    double v = c->by_F ? win->F[j] : win->disks[j].r;
     if (isnan(v))
         return NO_VALUE;
     if (!(c->hi > c->lo))
@@ -76,161 +78,264 @@ static int grain_class(const colouring *c, const gp_disk *d, size_t i)
 }
 
 /* How the disks' joint rings are drawn: as a stroke centred between r and R, one width
- * for the whole picture when the joint is constant. */
+ * for the whole picture when the joint is constant (within rounding: R - r of a constant
+ * joint j differs from j by a few ulps of R). */
+#define JOINT_CONSTANT_RTOL 1e-12
+
 typedef struct rings {
     int has_joint, constant;
     double width;
 } rings;
 
-static rings ring_style(const gp_packing *p)
+static rings ring_style(const gp_pack_stats *st)
 {
-    rings s = {0, 1, p->count ? p->disks[0].R - p->disks[0].r : 0.0};
-    for (size_t i = 1; i < p->count && s.constant; i++)
-        s.constant = fabs((p->disks[i].R - p->disks[i].r) - s.width) <= 1e-12 * p->disks[0].R;
+    double tol = JOINT_CONSTANT_RTOL * (st->r_max + st->joint_max);
+    rings s = {0, st->joint_max - st->joint_min <= tol, st->joint_min};
     s.has_joint = !s.constant || s.width > 0.0;
     return s;
 }
 
-static void draw_disks(FILE *out, const gp_result *result, const colouring *c, double H, int dec)
+/* What the steps share. */
+typedef struct svg_state {
+    colouring c;
+    rings rings;
+    double H; /* the domain's height: y is flipped (SVG's y points down) */
+    int dec;  /* decimals of coordinates */
+} svg_state;
+
+/* Decimals of coordinates: a ten-thousandth of the picture (a tenth of a pixel of the
+ * 1000-pixel picture, so ten times zoomed in a viewer still shows no rounding), or a
+ * fiftieth of the smallest grain, whichever is finer. */
+static int svg_decimals(const gp_spec *spec)
 {
-    const gp_packing *p = &result->packing;
-    rings s = ring_style(p);
-    for (int cls = c->F ? NO_VALUE : 0; cls < COLOR_CLASSES; cls++) {
-        char color[8];
-        class_color(cls, color);
-        fprintf(out, "<g fill=\"%s\"", color);
-        if (s.has_joint) {
-            fprintf(out, " stroke=\"" JOINT "\"");
-            if (s.constant)
-                fprintf(out, " stroke-width=\"%.*f\"", dec + 1, s.width);
-        }
-        fputs(">\n", out);
-        for (size_t i = 0; i < p->count; i++) {
-            const gp_disk *d = &p->disks[i];
-            if (grain_class(c, d, i) != cls)
-                continue;
-            fprintf(out, "<circle cx=\"%.*f\" cy=\"%.*f\" r=\"%.*f\"", dec, d->x, dec, H - d->y,
-                    dec + 1, s.has_joint ? 0.5 * (d->r + d->R) : d->r);
-            if (s.has_joint && !s.constant)
-                fprintf(out, " stroke-width=\"%.*f\"", dec + 1, d->R - d->r);
-            fputs("/>\n", out);
-        }
-        fputs("</g>\n", out);
-    }
+    double W = spec->domain.width, H = spec->domain.height, L = W > H ? W : H;
+    double r_lo, r_hi;
+    gp_distribution_support(&spec->dist, &r_lo, &r_hi);
+    double resolution = fmin(L * 1e-4, r_lo / 50.0);
+    int decimals = (int)ceil(-log10(resolution));
+    return decimals < 0 ? 0 : (decimals > 9 ? 9 : decimals);
 }
 
-static void draw_cells(FILE *out, const gp_spec *spec, const gp_result *result,
-                       const colouring *c, double H, int dec)
+/* ' name="v"' with v at `dec` decimals (`name` a literal, up to the opening quote). */
+#define attr(out, name, v, dec) \
+    (GP_OUT_LITERAL(out, name), gp_out_fixed(out, v, dec), gp_out_char(out, '"'))
+
+/* Opens the group of colour class cls. */
+static void open_group(gp_writer *w, gp_out *out, int cls)
 {
-    const gp_packing *p = &result->packing;
-    const gp_cells *cells = &result->cells;
-    fprintf(out, "<rect x=\"0\" y=\"0\" width=\"%.17g\" height=\"%.17g\" fill=\"" JOINT "\"/>\n",
-            spec->domain.width, H);
-    for (int cls = c->F ? NO_VALUE : 0; cls < COLOR_CLASSES; cls++) {
-        char color[8];
-        class_color(cls, color);
-        fprintf(out, "<g fill=\"%s\">\n", color);
-        for (size_t i = 0; i < cells->count; i++) {
-            if (grain_class(c, &p->disks[i], i) != cls)
-                continue;
-            fputs("<polygon points=\"", out);
-            for (size_t k = cells->start[i]; k < cells->start[i + 1]; k++)
-                fprintf(out, "%s%.*f,%.*f", k > cells->start[i] ? " " : "", dec, cells->xy[2 * k],
-                        dec, H - cells->xy[2 * k + 1]);
-            fputs("\"/>\n", out);
-        }
-        fputs("</g>\n", out);
+    svg_state *st = w->state;
+    char color[8];
+    class_color(cls, color);
+    GP_OUT_LITERAL(out, "<g fill=\"");
+    gp_out_puts(out, color);
+    gp_out_char(out, '"');
+    if (!w->result->has_cells && st->rings.has_joint) {
+        gp_out_puts(out, " stroke=\"" JOINT "\"");
+        if (st->rings.constant)
+            attr(out, " stroke-width=\"", st->rings.width, st->dec + 1);
     }
-    if (!spec->picture_disks)
+    GP_OUT_LITERAL(out, ">\n");
+}
+
+static void close_group(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, "</g>\n");
+}
+
+static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int cls)
+{
+    svg_state *st = w->state;
+    if (grain_class(&st->c, win, j) != cls)
         return;
-    double r_min, r_max;
-    gp_distribution_support(&spec->dist, &r_min, &r_max);
-    fprintf(out, "<g fill=\"none\" stroke=\"" OUTLINE "\" stroke-width=\"%.*f\">\n", dec + 1,
-            0.04 * r_min);
-    for (size_t i = 0; i < p->count; i++)
-        fprintf(out, "<circle cx=\"%.*f\" cy=\"%.*f\" r=\"%.*f\"/>\n", dec, p->disks[i].x, dec,
-                H - p->disks[i].y, dec + 1, p->disks[i].r);
-    fputs("</g>\n", out);
+    const gp_disk *d = &win->disks[j];
+    int dec = st->dec;
+    attr(out, "<circle cx=\"", d->x, dec);
+    attr(out, " cy=\"", st->H - d->y, dec);
+    attr(out, " r=\"", st->rings.has_joint ? 0.5 * (d->r + d->R) : d->r, dec + 1);
+    if (st->rings.has_joint && !st->rings.constant)
+        attr(out, " stroke-width=\"", d->R - d->r, dec + 1);
+    GP_OUT_LITERAL(out, "/>\n");
 }
 
-/* The colour bar, its labels, and a caption of what the picture shows. */
-static void draw_legend(FILE *out, const gp_spec *spec, const gp_result *result,
-                        const colouring *c, double font, double bar_h, int dec)
+static void cell(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int cls)
 {
-    const gp_pack_stats *st = &result->stats;
-    double W = spec->domain.width, H = spec->domain.height;
-    double bar_y = H + 0.03 * (W > H ? W : H), seg_w = W / COLOR_CLASSES;
+    svg_state *st = w->state;
+    if (grain_class(&st->c, win, j) != cls)
+        return;
+    GP_OUT_LITERAL(out, "<polygon points=\"");
+    for (size_t k = win->start[j]; k < win->start[j + 1]; k++) {
+        const double *v = &win->xy[2 * (k - win->vertex_base)];
+        if (k > win->start[j])
+            gp_out_char(out, ' ');
+        gp_out_fixed(out, v[0], st->dec);
+        gp_out_char(out, ',');
+        gp_out_fixed(out, st->H - v[1], st->dec);
+    }
+    GP_OUT_LITERAL(out, "\"/>\n");
+}
+
+static void outline_group(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    double r_min, r_max;
+    gp_distribution_support(&w->spec->dist, &r_min, &r_max);
+    gp_out_puts(out, "<g fill=\"none\" stroke=\"" OUTLINE "\"");
+    attr(out, " stroke-width=\"", 0.04 * r_min, st->dec + 1);
+    GP_OUT_LITERAL(out, ">\n");
+}
+
+static void outline(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    const gp_disk *d = &win->disks[j];
+    attr(out, "<circle cx=\"", d->x, st->dec);
+    attr(out, " cy=\"", st->H - d->y, st->dec);
+    attr(out, " r=\"", d->r, st->dec + 1);
+    GP_OUT_LITERAL(out, "/>\n");
+}
+
+/* A rectangle over the domain, x = 0, y = 0, with what follows as its last attributes. */
+static void domain_rect(gp_writer *w, gp_out *out, const char *rest)
+{
+    GP_OUT_LITERAL(out, "<rect x=\"0\" y=\"0\" width=\"");
+    gp_out_double(out, w->spec->domain.width);
+    GP_OUT_LITERAL(out, "\" height=\"");
+    gp_out_double(out, w->spec->domain.height);
+    gp_out_puts(out, rest);
+}
+
+static void head(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    const gp_pack_stats *stats = &w->result->stats;
+    double W = w->spec->domain.width, H = w->spec->domain.height;
+    double L = W > H ? W : H;
+    int dec = st->dec;
+    double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
+    double legend_h = bar_h + (3.5 + 1.4 * (w->result->has_balance + w->result->has_cells)) * font;
+    double vw = W + 2 * margin, vh = H + 2 * margin + legend_h;
+    double px = PICTURE_PX / L;
+    gp_out_puts(out, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                     "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"");
+    gp_out_fixed(out, -margin, dec);
+    gp_out_char(out, ' ');
+    gp_out_fixed(out, -margin, dec);
+    gp_out_char(out, ' ');
+    gp_out_fixed(out, vw, dec);
+    gp_out_char(out, ' ');
+    gp_out_fixed(out, vh, dec);
+    attr(out, "\" width=\"", vw * px, 0);
+    attr(out, " height=\"", vh * px, 0);
+    GP_OUT_LITERAL(out, ">\n<title>grainpack: ");
+    gp_out_uint(out, stats->count);
+    GP_OUT_LITERAL(out, " grains in ");
+    gp_out_double(out, W);
+    GP_OUT_LITERAL(out, " x ");
+    gp_out_double(out, H);
+    gp_out_printf(out, ", packing density %.4f</title>\n", stats->packing_density);
+    attr(out, "<rect x=\"", -margin, st->dec);
+    attr(out, " y=\"", -margin, st->dec);
+    attr(out, " width=\"", vw, st->dec);
+    attr(out, " height=\"", vh, st->dec);
+    GP_OUT_LITERAL(out, " fill=\"white\"/>\n");
+    domain_rect(w, out, "\" fill=\"" BACKGROUND "\"/>\n");
+    if (w->result->has_cells) /* the band between the cells */
+        domain_rect(w, out, "\" fill=\"" JOINT "\"/>\n");
+}
+
+/* The domain's outline, the colour bar, its labels, and a caption of what the picture
+ * shows. */
+static void legend(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    const colouring *c = &st->c;
+    const gp_result *result = w->result;
+    const gp_pack_stats *stats = &result->stats;
+    double W = w->spec->domain.width, H = w->spec->domain.height, L = W > H ? W : H;
+    double font = 0.022 * L, bar_h = 0.025 * L;
+    int dec = st->dec;
+    domain_rect(w, out, "\" fill=\"none\" stroke=\"" OUTLINE "\"");
+    attr(out, " stroke-width=\"", 0.002 * L, dec);
+    GP_OUT_LITERAL(out, "/>\n");
+    double bar_y = H + 0.03 * L, seg_w = W / COLOR_CLASSES;
     for (int cls = 0; cls < COLOR_CLASSES; cls++) {
         char color[8];
         class_color(cls, color);
-        fprintf(out, "<rect x=\"%.*f\" y=\"%.*f\" width=\"%.*f\" height=\"%.*f\" fill=\"%s\"/>\n",
-                dec, seg_w * cls, dec, bar_y, dec, seg_w * 1.01, dec, bar_h, color);
+        attr(out, "<rect x=\"", seg_w * cls, dec);
+        attr(out, " y=\"", bar_y, dec);
+        attr(out, " width=\"", seg_w * 1.01, dec);
+        attr(out, " height=\"", bar_h, dec);
+        GP_OUT_LITERAL(out, " fill=\"");
+        gp_out_puts(out, color);
+        GP_OUT_LITERAL(out, "\"/>\n");
     }
     double text_y = bar_y + bar_h + 1.1 * font;
-    fprintf(out,
-            "<g font-family=\"sans-serif\" font-size=\"%.*f\" fill=\"" OUTLINE "\">\n"
-            "<text x=\"0\" y=\"%.*f\">%s = %.4g</text>\n"
-            "<text x=\"%.*f\" y=\"%.*f\" text-anchor=\"middle\">%s%s</text>\n"
-            "<text x=\"%.*f\" y=\"%.*f\" text-anchor=\"end\">%s = %.4g</text>\n",
-            dec, font, dec, text_y, c->symbol, c->lo, dec, W / 2, dec, text_y, c->title,
-            c->F ? " (grey: not interior, F undefined)" : "", dec, W, dec, text_y, c->symbol, c->hi);
-    fprintf(out, "<text x=\"0\" y=\"%.*f\">%zu grains, packing density %.4f, grain fraction %.4f, seed %llu",
-            dec, text_y + 1.4 * font, st->count, st->packing_density, st->grain_fraction,
-            (unsigned long long)spec->seed);
-    fputs("</text>\n", out);
+    attr(out, "<g font-family=\"sans-serif\" font-size=\"", font, dec);
+    gp_out_puts(out, " fill=\"" OUTLINE "\">\n");
+    attr(out, "<text x=\"0\" y=\"", text_y, dec);
+    gp_out_printf(out, ">%s = %.4g</text>\n", c->symbol, c->lo);
+    attr(out, "<text x=\"", W / 2, dec);
+    attr(out, " y=\"", text_y, dec);
+    gp_out_printf(out, " text-anchor=\"middle\">%s%s</text>\n", c->title,
+                  c->by_F ? " (grey: not interior, F undefined)" : "");
+    attr(out, "<text x=\"", W, dec);
+    attr(out, " y=\"", text_y, dec);
+    gp_out_printf(out, " text-anchor=\"end\">%s = %.4g</text>\n", c->symbol, c->hi);
     double line_y = text_y + 1.4 * font;
+    attr(out, "<text x=\"0\" y=\"", line_y, dec);
+    gp_out_printf(out, ">%zu grains, packing density %.4f, grain fraction %.4f, seed %llu</text>\n",
+                  stats->count, stats->packing_density, stats->grain_fraction,
+                  (unsigned long long)w->spec->seed);
     const gp_balance_result *b = &result->balance;
-    if (result->has_balance && b->after_only)
-        fprintf(out, "<text x=\"0\" y=\"%.*f\">%s balancing: F_max %.3f, mean F %.3f</text>\n", dec,
-                line_y += 1.4 * font, gp_balance_method_name(b->method), b->after.max, b->after.mean);
-    else if (result->has_balance)
-        fprintf(out, "<text x=\"0\" y=\"%.*f\">%s balancing: F_max %.3f to %.3f, mean F %.3f to %.3f</text>\n",
-                dec, line_y += 1.4 * font, gp_balance_method_name(b->method), b->before.max,
-                b->after.max, b->before.mean, b->after.mean);
-    if (result->has_cells)
-        fprintf(out, "<text x=\"0\" y=\"%.*f\">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
-                dec, line_y += 1.4 * font, gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);
-    fputs("</g>\n", out);
+    if (result->has_balance) {
+        attr(out, "<text x=\"0\" y=\"", line_y += 1.4 * font, dec);
+        if (b->after_only)
+            gp_out_printf(out, ">%s balancing: F_max %.3f, mean F %.3f</text>\n",
+                          gp_balance_method_name(b->method), b->after.max, b->after.mean);
+        else
+            gp_out_printf(out, ">%s balancing: F_max %.3f to %.3f, mean F %.3f to %.3f</text>\n",
+                          gp_balance_method_name(b->method), b->before.max, b->after.max,
+                          b->before.mean, b->after.mean);
+    }
+    if (result->has_cells) {
+        attr(out, "<text x=\"0\" y=\"", line_y += 1.4 * font, dec);
+        gp_out_printf(out, ">Laguerre cells (%s shrink): boundary band %.3f of the area</text>\n",
+                      gp_shrink_name(result->cells.shrink), result->cell_stats.band_fraction);
+    }
+    GP_OUT_LITERAL(out, "</g>\n</svg>\n");
 }
 
-int gp_write_svg(FILE *out, const gp_spec *spec, const gp_result *result)
+int gp_plan_svg(gp_writer *w)
 {
-    const gp_pack_stats *st = &result->stats;
-    double W = spec->domain.width, H = spec->domain.height;
-    double L = W > H ? W : H;
-    double r_lo, r_hi;
-    gp_distribution_support(&spec->dist, &r_lo, &r_hi);
-    colouring c = choose_colouring(spec, result);
-
-    /* decimals: a ten-thousandth of the picture, or a fiftieth of the smallest grain */
-    double resolution = fmin(L * 1e-4, r_lo / 50.0);
-    int decimals = (int)ceil(-log10(resolution));
-    decimals = decimals < 0 ? 0 : (decimals > 9 ? 9 : decimals);
-
-    double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
-    double legend_h = bar_h + (3.5 + 1.4 * (result->has_balance + result->has_cells)) * font;
-    double vw = W + 2 * margin, vh = H + 2 * margin + legend_h;
-    double px = PICTURE_PX / L;
-    fprintf(out,
-            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.*f %.*f %.*f %.*f\" "
-            "width=\"%.0f\" height=\"%.0f\">\n",
-            decimals, -margin, decimals, -margin, decimals, vw, decimals, vh, vw * px, vh * px);
-    fprintf(out, "<title>grainpack: %zu grains in %g x %g, packing density %.4f</title>\n",
-            st->count, W, H, st->packing_density);
-    fprintf(out, "<rect x=\"%.*f\" y=\"%.*f\" width=\"%.*f\" height=\"%.*f\" fill=\"white\"/>\n",
-            decimals, -margin, decimals, -margin, decimals, vw, decimals, vh);
-    fprintf(out, "<rect x=\"0\" y=\"0\" width=\"%.17g\" height=\"%.17g\" fill=\"" BACKGROUND "\"/>\n",
-            W, H);
-    if (result->has_cells)
-        draw_cells(out, spec, result, &c, H, decimals);
-    else
-        draw_disks(out, result, &c, H, decimals);
-    fprintf(out,
-            "<rect x=\"0\" y=\"0\" width=\"%.17g\" height=\"%.17g\" fill=\"none\" "
-            "stroke=\"" OUTLINE "\" stroke-width=\"%.*f\"/>\n",
-            W, H, decimals, 0.002 * L);
-    draw_legend(out, spec, result, &c, font, bar_h, decimals);
-    fputs("</svg>\n", out);
-    return ferror(out) ? GP_EIO : 0;
+    svg_state *st = calloc(1, sizeof *st);
+    if (!st)
+        return GP_ENOMEM;
+    w->state = st;
+    st->c = choose_colouring(w->spec, w->result);
+    st->rings = ring_style(&w->result->stats);
+    st->H = w->spec->domain.height;
+    st->dec = svg_decimals(w->spec);
+    unsigned needs = GP_GRAINS_DISKS | (st->c.by_F ? GP_GRAINS_F : 0);
+    gp_writer_text(w, head, 0);
+    for (int cls = st->c.by_F ? NO_VALUE : 0; cls < COLOR_CLASSES; cls++) {
+        gp_writer_text(w, open_group, cls);
+        if (w->result->has_cells)
+            gp_writer_grains(w, cell, needs | GP_GRAINS_POLYGONS, cls);
+        else
+            gp_writer_grains(w, disk, needs, cls);
+        gp_writer_text(w, close_group, 0);
+    }
+    if (w->result->has_cells && w->spec->picture_disks) {
+        gp_writer_text(w, outline_group, 0);
+        gp_writer_grains(w, outline, GP_GRAINS_DISKS, 0);
+        gp_writer_text(w, close_group, 0);
+    }
+    gp_writer_text(w, legend, 0);
+    return 0;
 }

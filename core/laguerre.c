@@ -369,13 +369,14 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
     bd.ring_start = malloc((n + 1) * sizeof *bd.ring_start);
     int rc = 0;
     if (!out->start || !out->nstart || !out->area || !out->xy || !out->neighbours || !bd.ring_start ||
-        gp_rt_rings(rt, bd.ring_start, NULL, &bd.rings)) {
-        rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells of %zu disks", n);
+        (rc = gp_rt_rings(rt, bd.ring_start, NULL, &bd.rings, progress))) {
+        rc = rc == GP_ECANCELED ? gp_error_set(err, GP_ECANCELED, NULL, "laguerre cells canceled")
+                                : gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells of %zu disks", n);
         goto done;
     }
     for (size_t i = 0; i < n; i++) {
         if (progress && i % CELLS_PER_REPORT == CELLS_PER_REPORT - 1) {
-            if (progress->cancel && atomic_load_explicit(progress->cancel, memory_order_relaxed)) {
+            if (gp_canceled(progress->cancel)) {
                 rc = gp_error_set(err, GP_ECANCELED, NULL, "laguerre cells canceled");
                 goto done;
             }

@@ -2,6 +2,7 @@
 #include "grainpack/out.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -167,6 +168,18 @@ void gp_out_fixed(gp_out *o, double x, int decimals)
     }
     text[0] = '.';
     gp_out_write(o, text, (size_t)n + 1);
+}
+
+void gp_out_printf(gp_out *o, const char *format, ...)
+{
+    if (reserve(o, GP_OUT_PRINTF_MAX + 1))
+        return;
+    va_list ap;
+    va_start(ap, format);
+    int n = vsnprintf(o->buf + o->len, GP_OUT_PRINTF_MAX + 1, format, ap);
+    va_end(ap);
+    if (n > 0)
+        o->len += (size_t)n < GP_OUT_PRINTF_MAX ? (size_t)n : GP_OUT_PRINTF_MAX;
 }
 
 size_t gp_out_take(gp_out *o, char *dst, size_t max)

@@ -19,6 +19,15 @@ static void record(gp_result *result, const char *stage, double since)
         result->timings[result->ntimings++] = (gp_stage_time){stage, now_seconds() - since};
 }
 
+/* The check between two stages: a flag raised at the very end of one stops the next
+ * before it allocates anything. */
+static int between_stages(const gp_progress *progress, const char *next, gp_error *err)
+{
+    if (gp_canceled(gp_progress_cancel(progress)))
+        return gp_error_set(err, GP_ECANCELED, NULL, "canceled before the %s stage", next);
+    return 0;
+}
+
 int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
                     gp_result *result, gp_error *err)
 {
@@ -42,12 +51,15 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
     if (spec->balance_enabled || spec->laguerre_enabled) {
         /* one triangulation serves both stages: balancing keeps it up to date */
         t0 = now_seconds();
-        if ((rc = gp_rt_build(pk->disks, pk->count, &rt, err)))
+        if ((rc = between_stages(progress, "triangulation", err)) ||
+            (rc = gp_rt_build(pk->disks, pk->count, progress, &rt, err)))
             goto fail;
         record(result, "triangulation", t0);
     }
     if (spec->balance_enabled) {
         t0 = now_seconds();
+        if ((rc = between_stages(progress, "balance", err)))
+            goto fail;
         if ((rc = gp_balance(&spec->domain, pk->disks, pk->count, rt, &spec->balance, progress,
                              &result->balance, err)))
             goto fail;
@@ -56,7 +68,8 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
     }
     if (spec->laguerre_enabled) {
         t0 = now_seconds();
-        if ((rc = gp_laguerre(&spec->domain, pk->disks, pk->count, rt, &spec->laguerre, progress,
+        if ((rc = between_stages(progress, "laguerre", err)) ||
+            (rc = gp_laguerre(&spec->domain, pk->disks, pk->count, rt, &spec->laguerre, progress,
                               &result->cells, err)))
             goto fail;
         result->has_cells = 1;
@@ -65,7 +78,11 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
     gp_rt_free(rt);
     rt = NULL;
 
+    /* the statistics are a few passes over the disks and cells (milliseconds for a
+     * million disks): not interrupted inside */
     t0 = now_seconds();
+    if ((rc = between_stages(progress, "statistics", err)))
+        goto fail;
     rc = gp_pack_stats_compute(&spec->domain, &spec->dist, pk, &result->stats);
     if (rc == 0 && result->has_cells)
         rc = gp_cell_stats_compute(&spec->domain, &spec->dist, pk->disks, &result->cells,
@@ -89,7 +106,7 @@ int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
     if (!spec->balance_enabled && !spec->laguerre_enabled)
         return 0;
     gp_rt *rt;
-    int rc = gp_rt_build(pk->disks, pk->count, &rt, err);
+    int rc = gp_rt_build(pk->disks, pk->count, NULL, &rt, err);
     if (rc)
         return rc;
     if (spec->balance_enabled) {
@@ -100,7 +117,7 @@ int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
         b->count = pk->count;
         b->after_only = 1;
         b->F = malloc((pk->count ? pk->count : 1) * sizeof *b->F);
-        rc = b->F ? gp_quality(&spec->domain, rt, pk->disks, pk->count, b->F, &b->after, err)
+        rc = b->F ? gp_quality(&spec->domain, rt, pk->disks, pk->count, b->F, &b->after, NULL, err)
                   : gp_error_set(err, GP_ENOMEM, NULL, "out of memory for F");
         if (rc)
             gp_balance_result_free(b);

@@ -78,7 +78,7 @@ void quality_summarise(const double *F, size_t n, int histogram, gp_quality_stat
 }
 
 int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, gp_error *err)
+               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err)
 {
     memset(stats, 0, sizeof *stats);
     size_t cap = 64;
@@ -90,6 +90,10 @@ int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, s
         goto done;
     }
     for (size_t i = 0; i < n; i++) {
+        if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel)) {
+            rc = gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
+            goto done;
+        }
         int hull;
         size_t degree;
         while ((degree = gp_rt_ring(rt, (int32_t)i, ring, cap, &hull)) > cap) {

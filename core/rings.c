@@ -43,13 +43,15 @@ static size_t read_ring(const gp_rt *rt, int32_t i, int32_t **ids, size_t *cap, 
 /* Builds the next version in the spare arrays, the rings of the vertices with changed[i]
  * set read from rt and the others copied, then swaps it in. A tenth or so of the rings
  * change in a sweep: reading those one by one is cheaper than walking all of them. */
-static int build(rings *r, const gp_rt *rt, const uint8_t *changed)
+static int build(rings *r, const gp_rt *rt, const uint8_t *changed, const gp_cancel_flag *cancel)
 {
     /* the next version is about as long as this one: room for it and a little more */
     if (reserve(&r->spare_ids, &r->spare_cap, r->start[r->n] + r->start[r->n] / 16 + 64))
         return GP_ENOMEM;
     size_t at = 0;
     for (size_t i = 0; i < r->n; i++) {
+        if (i % GP_RT_RINGS_PER_CHECK == GP_RT_RINGS_PER_CHECK - 1 && gp_canceled(cancel))
+            return GP_ECANCELED;
         r->spare_start[i] = at;
         size_t degree;
         if (changed[i]) {
@@ -77,27 +79,29 @@ static int build(rings *r, const gp_rt *rt, const uint8_t *changed)
     return 0;
 }
 
-int rings_init(rings *r, const gp_rt *rt, size_t n)
+int rings_init(rings *r, const gp_rt *rt, size_t n, const gp_progress *progress)
 {
     memset(r, 0, sizeof *r);
     r->n = n;
     r->start = malloc((n + 1) * sizeof *r->start);
     r->spare_start = malloc((n + 1) * sizeof *r->spare_start);
     r->hull = malloc(n ? n : 1);
-    if (!r->start || !r->spare_start || !r->hull || gp_rt_rings(rt, r->start, r->hull, &r->ids)) {
+    int rc = !r->start || !r->spare_start || !r->hull ? GP_ENOMEM
+                                                      : gp_rt_rings(rt, r->start, r->hull, &r->ids, progress);
+    if (rc) {
         rings_free(r);
-        return GP_ENOMEM;
+        return rc;
     }
     r->cap = r->start[n];
     return 0;
 }
 
-int rings_refresh(rings *r, const gp_rt *rt, const uint8_t *changed)
+int rings_refresh(rings *r, const gp_rt *rt, const uint8_t *changed, const gp_cancel_flag *cancel)
 {
     size_t i = 0;
     while (i < r->n && !changed[i])
         i++;
-    return i == r->n ? 0 : build(r, rt, changed);
+    return i == r->n ? 0 : build(r, rt, changed, cancel);
 }
 
 void rings_free(rings *r)

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/progress.h"
 #include "grainpack/triangulation.h"
 
 /* Vertex i has the ring ids[start[i]] .. ids[start[i + 1] - 1], as gp_rt_ring gives it,
@@ -24,13 +25,16 @@ typedef struct rings {
     size_t spare_cap;
 } rings;
 
-/* Reads the rings of the n vertices of rt (ids 0 .. n-1) into r (gp_rt_rings). Returns 0
- * or GP_ENOMEM (r is then empty and only rings_free may follow). */
-int rings_init(rings *r, const gp_rt *rt, size_t n);
+/* Reads the rings of the n vertices of rt (ids 0 .. n-1) into r (gp_rt_rings, which reads
+ * the cancel flag of `progress`, may be NULL). Returns 0, GP_ENOMEM or GP_ECANCELED (r is
+ * then empty and only rings_free may follow). */
+int rings_init(rings *r, const gp_rt *rt, size_t n, const gp_progress *progress);
 
-/* Re-reads from rt the rings of the vertices with changed[i] set and keeps the others.
- * Returns 0 or GP_ENOMEM (only rings_free may then follow). */
-int rings_refresh(rings *r, const gp_rt *rt, const uint8_t *changed);
+/* Re-reads from rt the rings of the vertices with changed[i] set and keeps the others;
+ * *cancel (may be NULL) is read every GP_RT_RINGS_PER_CHECK vertices (after a rebuild
+ * every ring is read again). Returns 0, GP_ENOMEM or GP_ECANCELED (only rings_free may
+ * then follow). */
+int rings_refresh(rings *r, const gp_rt *rt, const uint8_t *changed, const gp_cancel_flag *cancel);
 
 void rings_free(rings *r);
 

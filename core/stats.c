@@ -83,6 +83,11 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
             out->r_min = d->r;
         if (i == 0 || d->r > out->r_max)
             out->r_max = d->r;
+        double joint = d->R - d->r;
+        if (i == 0 || joint < out->joint_min)
+            out->joint_min = joint;
+        if (i == 0 || joint > out->joint_max)
+            out->joint_max = joint;
         long b = gp_bin_table_find(out->bins, nbins, d->r);
         if (b >= 0)
             out->bins[b].count++;

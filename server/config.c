@@ -20,6 +20,10 @@
 /* A job at the default disk cap packs in seconds; ten minutes leaves room for slow
  * stages and a loaded machine, and still frees a worker held by a runaway job. */
 #define DEFAULT_MAX_JOB_SECONDS 600.0
+/* A job is run at most this many times: one that was running each time the daemon died
+ * (a crash, a kill, a stop it did not answer) is failed instead of claimed at every
+ * start. Three lets a job survive two unrelated crashes or kills of the node. */
+#define DEFAULT_MAX_JOB_ATTEMPTS 3
 /* Enough for a script that submits a parameter sweep, far below the queue's size, so
  * that one user cannot fill the queue for everyone. */
 #define DEFAULT_MAX_JOBS_PER_KEY ((size_t)100)
@@ -30,7 +34,8 @@
  * address, and far below the file descriptor limit. */
 #define DEFAULT_MAX_CONNECTIONS 1024
 #define DEFAULT_MAX_CONNECTIONS_PER_IP 128
-/* A client that sends nothing for this long is disconnected (a slow-loris defence). A
+/* A client that sends nothing for this long is disconnected, and so is one whose request
+ * head is not complete this long after it began (a slow-loris defence: see peers.h). A
  * long-poll is not affected: a suspended connection is not timed out. */
 #define DEFAULT_CONNECTION_TIMEOUT 30
 
@@ -70,6 +75,9 @@ static const option options[] = {
     {"--max-job-seconds", "GRAINPACKD_MAX_JOB_SECONDS",
      "seconds a job may run before it is stopped and failed (default 600; 0: no limit)",
      SECONDS(max_job_seconds, 0, 10000000)},
+    {"--max-job-attempts", "GRAINPACKD_MAX_JOB_ATTEMPTS",
+     "times a job is started before a job the daemon died running is failed (default 3)",
+     INT(max_job_attempts, 1, 1000)},
     {"--max-jobs-per-key", "GRAINPACKD_MAX_JOBS_PER_KEY",
      "accepted and running jobs one API key may have before 429 (default 100; 0: no limit)",
      SIZE(max_jobs_per_key, 0, (size_t)1 << 30)},
@@ -84,7 +92,8 @@ static const option options[] = {
      "connections open at once from one address before 429 (default 128)",
      INT(max_connections_per_ip, 1, 1000000)},
     {"--connection-timeout", "GRAINPACKD_CONNECTION_TIMEOUT",
-     "seconds a client may stay silent before it is disconnected (default 30)",
+     "seconds a client may stay silent, or take to send a request head, before it is "
+     "disconnected (default 30)",
      INT(connection_timeout, 1, 3600)},
     {"--key-file", "GRAINPACKD_KEY_FILE",
      "API keys (see README, Access control); without it the service is open to anyone",
@@ -177,6 +186,7 @@ int gp_config_load(gp_config *cfg, int argc, char **argv, FILE *out, FILE *err)
     cfg->max_disks = DEFAULT_MAX_DISKS;
     cfg->max_bins = DEFAULT_MAX_BINS;
     cfg->max_job_seconds = DEFAULT_MAX_JOB_SECONDS;
+    cfg->max_job_attempts = DEFAULT_MAX_JOB_ATTEMPTS;
     cfg->max_jobs_per_key = DEFAULT_MAX_JOBS_PER_KEY;
     cfg->max_wait = DEFAULT_MAX_WAIT;
     cfg->max_header_bytes = DEFAULT_MAX_HEADER_BYTES;

@@ -20,6 +20,9 @@ typedef struct gp_config {
     size_t max_bins;          /* --max-bins / GRAINPACKD_MAX_BINS histogram bins, default 10000 */
     double max_job_seconds;   /* --max-job-seconds / GRAINPACKD_MAX_JOB_SECONDS of running per
                                  job, default 600; 0: no limit */
+    int max_job_attempts;     /* --max-job-attempts / GRAINPACKD_MAX_JOB_ATTEMPTS: times a job is
+                                 started; one the daemon died running that often is failed at
+                                 the next start instead of queued again; default 3 */
     size_t max_jobs_per_key;  /* --max-jobs-per-key / GRAINPACKD_MAX_JOBS_PER_KEY accepted and
                                  running jobs of one key, default 100; 0: no limit */
     int max_wait;             /* --max-wait / GRAINPACKD_MAX_WAIT seconds of long-poll, default 60 */
@@ -29,7 +32,8 @@ typedef struct gp_config {
     int max_connections_per_ip; /* --max-connections-per-ip / GRAINPACKD_MAX_CONNECTIONS_PER_IP,
                                    default 128 */
     int connection_timeout;   /* --connection-timeout / GRAINPACKD_CONNECTION_TIMEOUT seconds a
-                                 silent client keeps its connection, default 30 */
+                                 silent client keeps its connection, and a request head may
+                                 take, default 30 */
     char key_file[PATH_MAX];  /* --key-file / GRAINPACKD_KEY_FILE: API keys; "" runs open */
     int insecure_open;        /* --insecure-open / GRAINPACKD_INSECURE_OPEN=1: run open (no key
                                  file) on an address other than loopback */

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "framing.h"
 #include "log.h"
 #include "peers.h"
 #include "problem.h"
@@ -33,6 +34,11 @@
 #define BODY_DEADLINE_FACTOR 2
 /* The listen queue: enough for a burst of a few hundred clients connecting at once. */
 #define LISTEN_BACKLOG 1024
+/* The buffer of a streamed response (a result download), filled by its producer each
+ * time the socket has taken the last one: large enough that a callback's fixed cost
+ * (a store connection, a window of the result) is spread over many bytes, small enough
+ * that 20 downloads at once hold a few megabytes. */
+#define STREAM_BLOCK ((size_t)128 * 1024)
 
 /* Per-request state, from the first call of a request to its completion. */
 typedef struct request_state {
@@ -53,6 +59,8 @@ typedef struct request_state {
     unsigned status;
     size_t bytes;
     double t0;
+    int begun;               /* the first call came: the head is in */
+    size_t query_parameters; /* more than GP_MAX_QUERY_PARAMETERS: the query was cut */
 } request_state;
 
 static const char *mhd_header(void *conn, const char *name)
@@ -77,7 +85,13 @@ static void mhd_resume(void *conn)
     MHD_resume_connection(conn);
 }
 
-const gp_suspender gp_http_suspender = {mhd_suspend, mhd_resume};
+static int mhd_socket(void *conn)
+{
+    const union MHD_ConnectionInfo *info = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    return info ? info->connect_fd : -1;
+}
+
+const gp_suspender gp_http_suspender = {mhd_suspend, mhd_resume, mhd_socket};
 
 /* The gp_request of a libmicrohttpd request as far as st has it (no body: the caller
  * adds it once it is in). */
@@ -107,7 +121,8 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     if (!any)
         MHD_add_response_header(resp, "Vary", "Origin");
     MHD_add_response_header(resp, "Access-Control-Expose-Headers",
-                            "Location, Retry-After, Content-Type, WWW-Authenticate");
+                            "Location, Retry-After, Content-Type, WWW-Authenticate, ETag, "
+                            "Content-Disposition");
     if (preflight && rt) {
         char allow[64];
         gp_router_allow(rt, allow, sizeof allow);
@@ -118,13 +133,37 @@ static void add_cors(gp_service *svc, struct MHD_Connection *conn, struct MHD_Re
     }
 }
 
-/* A response holding reply's body (it is the response's once this returns non-NULL). */
+/* libmicrohttpd's reader of a streamed body: gp_body_stream's fill, in its terms. */
+static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    (void)pos;
+    gp_body_stream *s = cls;
+    long n = s->fill(s, buf, max);
+    return n > 0 ? (ssize_t)n : n == 0 ? MHD_CONTENT_READER_END_OF_STREAM
+                                       : MHD_CONTENT_READER_END_WITH_ERROR;
+}
+
+static void stream_release(void *cls)
+{
+    gp_body_stream *s = cls;
+    s->release(s);
+}
+
+/* A response taking reply's body or stream (the response's once this returns non-NULL);
+ * NULL when out of memory. */
 static struct MHD_Response *create_response(gp_reply *reply)
 {
+    struct MHD_Response *resp;
+    if (reply->stream) {
+        resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, STREAM_BLOCK, stream_read,
+                                                 reply->stream, stream_release);
+        if (resp)
+            reply->stream = NULL;
+        return resp;
+    }
     int owned = reply->body && !reply->persistent;
-    struct MHD_Response *resp = MHD_create_response_from_buffer(
-        reply->len, reply->body ? reply->body : (void *)"",
-        owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+    resp = MHD_create_response_from_buffer(reply->len, reply->body ? reply->body : (void *)"",
+                                           owned ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
     if (resp && owned)
         reply->body = NULL;
     return resp;
@@ -156,6 +195,8 @@ static enum MHD_Result respond(gp_service *svc, struct MHD_Connection *conn, req
         snprintf(seconds, sizeof seconds, "%d", reply->retry_after);
         MHD_add_response_header(resp, "Retry-After", seconds);
     }
+    for (int i = 0; i < reply->nheaders; i++)
+        MHD_add_response_header(resp, reply->headers[i].name, reply->headers[i].value);
     if (reply->close)
         MHD_add_response_header(resp, "Connection", "close");
     if (reply->vary)
@@ -212,15 +253,45 @@ static enum MHD_Result add_size(void *cls, enum MHD_ValueKind kind, const char *
     return MHD_YES;
 }
 
+/* Records a header for the framing checks (cls: a gp_framing). */
+static enum MHD_Result add_framing(void *cls, enum MHD_ValueKind kind, const char *key,
+                                   const char *value)
+{
+    (void)kind;
+    gp_framing_add(cls, key, value);
+    return MHD_YES;
+}
+
+/* The connection's record in the peer table, or NULL. */
+static gp_peer_conn *peer_of(struct MHD_Connection *conn)
+{
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    return info ? info->socket_context : NULL;
+}
+
 /* The first call of a request: the checks before its body. Returns the MHD result. */
 static enum MHD_Result begin_request(gp_service *svc, struct MHD_Connection *conn,
-                                     const char *url, const char *method, request_state *st)
+                                     const char *url, const char *method, const char *version,
+                                     request_state *st)
 {
     gp_reply reply;
     memset(&reply, 0, sizeof reply);
-    const union MHD_ConnectionInfo *info =
-        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-    const gp_peer_conn *peer = info ? info->socket_context : NULL;
+    gp_peer_conn *peer = peer_of(conn);
+    gp_peers_head_done(svc->peers, peer);
+    /* how the body is framed, before anything else: a request that a proxy in front could
+     * read another way is refused and its connection closed, whatever its route */
+    gp_framing framing;
+    gp_framing_init(&framing);
+    MHD_get_connection_values(conn, MHD_HEADER_KIND, add_framing, &framing);
+    if (gp_framing_check(&framing, version, url, &reply))
+        return respond(svc, conn, st, &reply, 0);
+    if (st->query_parameters) {
+        gp_problem(&reply, 400, GP_PROBLEM_BAD_PARAMETER, url,
+                   "the query has %zu parameters; a request takes at most %d", st->query_parameters,
+                   GP_MAX_QUERY_PARAMETERS);
+        return respond(svc, conn, st, &reply, 0);
+    }
     if (peer && peer->over_limit) {
         gp_problem(&reply, 429, GP_PROBLEM_TOO_MANY_CONNECTIONS, url,
                    "%u connections are open from your address, the limit is %d "
@@ -244,11 +315,31 @@ static enum MHD_Result begin_request(gp_service *svc, struct MHD_Connection *con
     return MHD_YES; /* the body (if any) comes in the next calls */
 }
 
+/* A request line arrived (before its query is parsed): the request's state begins. A
+ * query of more parameters than any route takes is cut here, before libmicrohttpd parses
+ * it into its connection's memory (see GP_MAX_QUERY_PARAMETERS); the request is refused
+ * at its first call. `uri` is libmicrohttpd's own buffer, the query then parsed from it:
+ * a NUL right after the '?' leaves an empty query. */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *conn)
+{
+    gp_service *svc = cls;
+    gp_peers_line_in(svc->peers, peer_of(conn));
+    request_state *st = calloc(1, sizeof *st);
+    if (!st)
+        return NULL; /* on_request tries again */
+    st->t0 = gp_monotonic_seconds();
+    size_t n = gp_query_parameters(uri);
+    if (n > GP_MAX_QUERY_PARAMETERS) {
+        st->query_parameters = n;
+        strchr(uri, '?')[1] = '\0';
+    }
+    return st;
+}
+
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
                                   const char *method, const char *version,
                                   const char *upload_data, size_t *upload_size, void **con_cls)
 {
-    (void)version;
     gp_service *svc = cls;
     request_state *st = *con_cls;
     gp_reply reply;
@@ -258,9 +349,12 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             return MHD_NO;
         *con_cls = st;
         st->t0 = gp_monotonic_seconds();
+    }
+    if (!st->begun) {
+        st->begun = 1;
         gp_text_sanitize(st->method, sizeof st->method, method);
         gp_text_sanitize(st->path, sizeof st->path, url);
-        return begin_request(svc, conn, url, method, st);
+        return begin_request(svc, conn, url, method, version, st);
     }
     if (st->answered)
         return MHD_YES;
@@ -323,8 +417,10 @@ static void client_address(struct MHD_Connection *conn, char *addr, size_t size)
 static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
-    (void)cls;
+    gp_service *svc = cls;
     request_state *st = *con_cls;
+    if (toe == MHD_REQUEST_TERMINATED_COMPLETED_OK) /* the next request's head begins */
+        gp_peers_head_begins(svc->peers, peer_of(conn));
     if (!st)
         return;
     if (st->answered) {
@@ -347,8 +443,11 @@ static void on_connection(void *cls, struct MHD_Connection *conn, void **socket_
     if (code == MHD_CONNECTION_NOTIFY_STARTED) {
         const union MHD_ConnectionInfo *info =
             MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+        const union MHD_ConnectionInfo *fd =
+            MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
         *socket_context = gp_peers_opened(svc->peers, info ? info->client_addr : NULL,
-                                          (unsigned)svc->cfg->max_connections_per_ip);
+                                          (unsigned)svc->cfg->max_connections_per_ip,
+                                          fd ? fd->connect_fd : -1);
     } else if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
         gp_peers_closed(svc->peers, *socket_context);
         *socket_context = NULL;
@@ -395,6 +494,7 @@ static struct MHD_Daemon *start(gp_service *svc, unsigned flags, uint16_t port,
     struct MHD_OptionItem options[] = {
         {MHD_OPTION_NOTIFY_COMPLETED, (intptr_t)on_completed, svc},
         {MHD_OPTION_NOTIFY_CONNECTION, (intptr_t)on_connection, svc},
+        {MHD_OPTION_URI_LOG_CALLBACK, (intptr_t)on_uri, svc},
         {MHD_OPTION_UNESCAPE_CALLBACK, (intptr_t)unescape, NULL},
         {MHD_OPTION_CONNECTION_LIMIT, cfg->max_connections, NULL},
         {MHD_OPTION_PER_IP_CONNECTION_LIMIT, cfg->max_connections_per_ip + PER_IP_HARD_MARGIN, NULL},

@@ -20,6 +20,13 @@
 #include "service.h"
 #include "workers.h"
 
+/* How long a stop waits for the workers. They return within milliseconds of their flag
+ * (bench/CANCEL.md); this bounds a stop when one does not (a stage that ignores its flag,
+ * a store write held up by another process's lock), well within systemd's default
+ * TimeoutStopSec of 90 s. Such a job stays running in the store and is queued again at
+ * the next start. */
+#define STOP_WORKERS_SECONDS 5.0
+
 /* Creates the directory that holds the database file, if missing (one level). */
 static int make_db_dir(const char *db_path)
 {
@@ -94,8 +101,10 @@ int main(int argc, char **argv)
     svc.started = gp_monotonic_seconds();
     atomic_init(&svc.queued, 0);
     atomic_init(&svc.accepting, 1);
+    atomic_init(&svc.http.open, 0);
+    atomic_init(&svc.http.slow_heads, 0);
     struct MHD_Daemon *http = NULL;
-    int status = 1, requeued = 0, lock_fd = -1;
+    int status = 1, requeued = 0, given_up = 0, lock_fd = -1;
     char why[512];
     if (cfg.key_file[0]) {
         if (gp_keyring_load(cfg.key_file, &svc.keys, why, sizeof why)) {
@@ -109,20 +118,29 @@ int main(int argc, char **argv)
     }
     if (make_db_dir(cfg.db_path) || (lock_fd = lock_database(cfg.db_path)) < 0)
         goto done;
-    if (gp_store_open(cfg.db_path, &svc.store, &requeued, why, sizeof why)) {
+    if (gp_store_open(cfg.db_path, &svc.store, why, sizeof why)) {
         gp_log("cannot open the job store: %s", why);
         goto done;
     }
     gp_db *db = gp_store_acquire(svc.store, 1);
     long counts[GP_JOB_NSTATUS];
-    if (!db || gp_store_count(db, counts)) {
+    if (!db || gp_store_recover(db, cfg.max_job_attempts, &requeued, &given_up) ||
+        gp_store_count(db, counts)) {
         gp_store_release(svc.store, db);
         gp_log("cannot read the job store %s", cfg.db_path);
         goto done;
     }
     gp_store_release(svc.store, db);
+    if (given_up)
+        gp_log("%d jobs the daemon died running %d times failed instead of being queued again "
+               "(--max-job-attempts)", given_up, cfg.max_job_attempts);
     atomic_store(&svc.queued, counts[GP_JOB_ACCEPTED]);
-    if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
+    if (gp_cursor_keys_init(&svc.cursor_keys)) {
+        gp_log("cannot draw the page cursors' keys from the kernel's random source");
+        goto done;
+    }
+    if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new(&svc.http)) ||
+        gp_peers_watch(svc.peers, (double)cfg.connection_timeout) ||
         gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool)) {
         gp_log("out of memory starting up");
         goto done;
@@ -161,10 +179,20 @@ done:
     atomic_store(&svc.accepting, 0);
     if (http)
         gp_http_quiesce(http);
-    gp_pool_stop(svc.pool);
+    double stop_began = gp_monotonic_seconds();
+    int stuck = gp_pool_stop(svc.pool, STOP_WORKERS_SECONDS);
     gp_waiters_stop(svc.waiters);
     if (http)
         gp_http_stop(http);
+    if (stuck) {
+        /* those threads still use the pool, the store and the metrics: nothing is freed,
+         * the process ends here (sqlite's journal makes this as safe as a crash) */
+        gp_log("%d worker threads did not stop within %.0f s; their jobs stay running in the "
+               "store and are queued again at the next start; stopping now (%.1f s)",
+               stuck, STOP_WORKERS_SECONDS, gp_monotonic_seconds() - stop_began);
+        fflush(stderr);
+        _exit(status);
+    }
     gp_pool_free(svc.pool);
     gp_waiters_free(svc.waiters);
     gp_metrics_free(svc.metrics);

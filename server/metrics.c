@@ -16,8 +16,8 @@ static const double bucket_bounds[] = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025
                                        300};
 #define NBUCKETS (sizeof bucket_bounds / sizeof bucket_bounds[0])
 
-static const char *const outcome_names[] = {"successful", "failed",    "timed_out",
-                                            "dismissed",  "discarded", "requeued"};
+static const char *const outcome_names[] = {"successful", "failed",    "timed_out", "dismissed",
+                                            "discarded",  "requeued",  "abandoned"};
 #define NOUTCOMES (sizeof outcome_names / sizeof outcome_names[0])
 
 /* Durations are summed in microseconds so that the sum stays an atomic integer. */
@@ -31,6 +31,9 @@ typedef struct stage_histogram {
 struct gp_metrics {
     atomic_ulong requests[600]; /* by status code */
     atomic_ulong outcomes[NOUTCOMES];
+    atomic_ulong pipeline_runs;   /* gp_pipeline_run calls (and rederivations) */
+    atomic_long downloads;        /* result downloads streaming now */
+    atomic_ulong downloads_total; /* result downloads started */
     pthread_mutex_t stage_lock; /* taken only to claim a histogram for a new stage name */
     stage_histogram stages[GP_MAX_STAGES];
 };
@@ -55,6 +58,18 @@ void gp_metrics_request(gp_metrics *m, unsigned status)
 {
     if (status < 600)
         atomic_fetch_add(&m->requests[status], 1);
+}
+
+void gp_metrics_pipeline_run(gp_metrics *m)
+{
+    atomic_fetch_add(&m->pipeline_runs, 1);
+}
+
+void gp_metrics_download(gp_metrics *m, int delta)
+{
+    atomic_fetch_add(&m->downloads, delta);
+    if (delta > 0)
+        atomic_fetch_add(&m->downloads_total, 1);
 }
 
 void gp_metrics_outcome(gp_metrics *m, const char *outcome)
@@ -122,14 +137,38 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
             "# HELP grainpack_workers Worker threads.\n# TYPE grainpack_workers gauge\n"
             "grainpack_workers %d\n"
             "# HELP grainpack_workers_busy Workers running a job.\n"
-            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n",
-            g->queue_depth, g->workers, g->workers_busy);
+            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n"
+            "# HELP grainpack_workers_abandoned Worker threads given up on (told to stop, "
+            "still running after seconds; another took each one's place).\n"
+            "# TYPE grainpack_workers_abandoned gauge\ngrainpack_workers_abandoned %d\n",
+            g->queue_depth, g->workers, g->workers_busy, g->workers_abandoned);
+    fprintf(f,
+            "# HELP grainpack_http_slow_heads_total Connections answered 408 and closed: their "
+            "request head was not complete within --connection-timeout.\n"
+            "# TYPE grainpack_http_slow_heads_total counter\ngrainpack_http_slow_heads_total %lu\n"
+            "# HELP grainpack_http_long_polls_hung_up_total Long-polls ended because their "
+            "client closed the connection.\n"
+            "# TYPE grainpack_http_long_polls_hung_up_total counter\n"
+            "grainpack_http_long_polls_hung_up_total %lu\n"
+            "# HELP grainpack_http_connections HTTP connections open, waiting long-polls "
+            "included.\n# TYPE grainpack_http_connections gauge\ngrainpack_http_connections %ld\n",
+            g->slow_heads, g->polls_hung_up, g->connections);
     fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
           "# TYPE grainpack_job_runs_total counter\n",
           f);
     for (size_t i = 0; i < NOUTCOMES; i++)
         fprintf(f, "grainpack_job_runs_total{outcome=\"%s\"} %lu\n", outcome_names[i],
                 atomic_load(&m->outcomes[i]));
+    fprintf(f,
+            "# HELP grainpack_pipeline_runs_total Runs of the job pipeline (packing and the "
+            "stages after it) in this process: workers only; a download renders what is stored.\n"
+            "# TYPE grainpack_pipeline_runs_total counter\ngrainpack_pipeline_runs_total %lu\n"
+            "# HELP grainpack_downloads Result downloads being streamed now.\n"
+            "# TYPE grainpack_downloads gauge\ngrainpack_downloads %ld\n"
+            "# HELP grainpack_downloads_total Result downloads started (304 answers not counted).\n"
+            "# TYPE grainpack_downloads_total counter\ngrainpack_downloads_total %lu\n",
+            atomic_load(&m->pipeline_runs), atomic_load(&m->downloads),
+            atomic_load(&m->downloads_total));
     fputs("# HELP grainpack_stage_duration_seconds Wall-clock time of pipeline stages.\n"
           "# TYPE grainpack_stage_duration_seconds histogram\n",
           f);

@@ -22,6 +22,14 @@ void gp_metrics_request(gp_metrics *m, unsigned status);
  * DELETE: result dropped) or "requeued". */
 void gp_metrics_outcome(gp_metrics *m, const char *outcome);
 
+/* The job pipeline is about to run (a worker), or a stored result's stages to be derived
+ * again (the migration of a version 2 database): counted so that a test can tell that a
+ * download ran none. */
+void gp_metrics_pipeline_run(gp_metrics *m);
+
+/* A result download started (delta 1) or ended (delta -1). */
+void gp_metrics_download(gp_metrics *m, int delta);
+
 /* A pipeline stage took `seconds` (histogram per stage name; names are static strings
  * from the engine, at most GP_MAX_STAGES of them are tracked). */
 void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds);
@@ -30,7 +38,10 @@ void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds);
 typedef struct gp_metrics_gauges {
     long jobs[GP_JOB_NSTATUS]; /* jobs in the store by status */
     long queue_depth;          /* accepted jobs waiting for a worker */
-    int workers, workers_busy;
+    int workers, workers_busy, workers_abandoned;
+    unsigned long slow_heads;     /* connections closed for a late request head */
+    long connections;             /* HTTP connections open */
+    unsigned long polls_hung_up;  /* long-polls ended by their client's hang-up */
 } gp_metrics_gauges;
 
 /* The whole exposition as a malloc'd text (caller frees), NULL when out of memory. */

@@ -16,12 +16,14 @@ static const char *status_title(unsigned status)
     case 404: return "Not Found";
     case 405: return "Method Not Allowed";
     case 406: return "Not Acceptable";
+    case 408: return "Request Timeout";
     case 413: return "Content Too Large";
     case 414: return "URI Too Long";
     case 415: return "Unsupported Media Type";
     case 422: return "Unprocessable Content";
     case 429: return "Too Many Requests";
     case 431: return "Request Header Fields Too Large";
+    case 501: return "Not Implemented";
     case 503: return "Service Unavailable";
     default: return status >= 500 ? "Internal Server Error" : "Error";
     }
@@ -104,6 +106,11 @@ static const char out_of_memory_body[] =
 
 void gp_problem_out_of_memory(gp_reply *reply)
 {
+    if (reply->stream) { /* a download that could not start: its body and headers go */
+        reply->stream->release(reply->stream);
+        reply->stream = NULL;
+    }
+    reply->nheaders = 0;
     gp_reply_take(reply, 503, GP_PROBLEM_MEDIA_TYPE, (char *)out_of_memory_body,
                   sizeof out_of_memory_body - 1);
     reply->persistent = 1;

@@ -36,6 +36,9 @@
 #define GP_PROBLEM_URI_TOO_LONG "urn:grainpack:problem:uri-too-long"
 #define GP_PROBLEM_STORAGE_FULL "urn:grainpack:problem:storage-full"
 #define GP_PROBLEM_STORAGE_UNWRITABLE "urn:grainpack:problem:storage-unwritable"
+#define GP_PROBLEM_BAD_FRAMING "urn:grainpack:problem:bad-framing"
+#define GP_PROBLEM_UNSUPPORTED_CODING "urn:grainpack:problem:unsupported-transfer-coding"
+#define GP_PROBLEM_REQUEST_TIMEOUT "urn:grainpack:problem:request-timeout"
 
 /* Fills reply with a problem: status, type, the standard title of the status and a
  * printf-style detail. `instance` (the request path) may be NULL. Text that came from

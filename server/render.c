@@ -1,4 +1,4 @@
-/* render.c - format negotiation and re-rendering a stored result. */
+/* render.c - format and encoding negotiation, entity tags. */
 #include "render.h"
 
 #include <stdio.h>
@@ -6,6 +6,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "grainpack/version.h"
 #include "problem.h"
 
 /* Lists the formats as "json, csv, svg" (or their media types). */
@@ -110,45 +111,77 @@ int gp_render_choose_format(const gp_request *req, gp_format *out, gp_reply *rep
     return -1;
 }
 
-int gp_render_load(gp_db *db, const char *id, const char *owner, gp_spec *spec, gp_result *result)
+/* The q of a coding in Accept-Encoding, -1 when it is not named. */
+static double coding_quality(const char *header, const char *coding)
 {
-    memset(spec, 0, sizeof *spec);
-    memset(result, 0, sizeof *result);
-    char *text;
-    size_t len;
-    int rc = gp_store_load_result(db, id, owner, &text, &len, &result->packing);
-    if (rc)
-        return rc;
-    /* accepted once, so parsed without today's caps */
-    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
-    gp_error err;
-    rc = gp_spec_parse(text, len, &unlimited, spec, &err);
-    free(text);
-    if (rc == 0)
-        rc = gp_pack_stats_compute(&spec->domain, &spec->dist, &result->packing, &result->stats);
-    /* F and the Laguerre cells, rebuilt from the stored (balanced) disks */
-    if (rc == 0)
-        rc = gp_result_rederive(spec, result, &err);
-    if (rc) {
-        gp_spec_free(spec);
-        gp_result_free(result);
+    size_t n = strlen(coding);
+    for (const char *p = header; *p;) {
+        while (*p == ' ' || *p == ',')
+            p++;
+        const char *end = p + strcspn(p, ",");
+        size_t len = strcspn(p, ";, ");
+        if (len == n && strncasecmp(p, coding, n) == 0) {
+            const char *q = memchr(p, ';', (size_t)(end - p));
+            while (q && q < end) {
+                q++;
+                while (*q == ' ')
+                    q++;
+                if ((q[0] == 'q' || q[0] == 'Q') && q[1] == '=')
+                    return strtod(q + 2, NULL);
+                q = memchr(q, ';', (size_t)(end - q));
+            }
+            return 1.0;
+        }
+        p = end;
     }
-    return rc;
+    return -1.0;
 }
 
-int gp_render_format(const gp_spec *spec, const gp_result *result, gp_format format,
-                     char **body, size_t *len)
+int gp_render_accepts_gzip(const gp_request *req)
 {
-    *body = NULL;
-    FILE *f = open_memstream(body, len);
-    if (!f)
-        return GP_ENOMEM;
-    int rc = gp_write_result(f, format, spec, result);
-    if (fclose(f) != 0 && rc == 0)
-        rc = GP_ENOMEM;
-    if (rc) {
-        free(*body);
-        *body = NULL;
+    const char *header = gp_request_header(req, "Accept-Encoding");
+    if (!header)
+        return 0;
+    double gzip = coding_quality(header, "gzip"), xgzip = coding_quality(header, "x-gzip");
+    if (gzip < 0.0)
+        gzip = xgzip;
+    if (gzip < 0.0)
+        gzip = coding_quality(header, "*");
+    return gzip > 0.0;
+}
+
+void gp_render_etag(const gp_stored_result *res, const gp_spec *spec, gp_format format, int gzip,
+                    char *out)
+{
+    /* only the picture shows the colouring (?color= or the spec's) */
+    const char *color = format != GP_FORMAT_SVG ? ""
+                        : spec->picture_color == GP_PICTURE_COLOR_QUALITY ? "-quality"
+                                                                         : "-radius";
+    snprintf(out, GP_ETAG_SIZE, "\"%s-%s%s%s-%s.%d\"", res->version, gp_format_name(format),
+             color, gzip ? "-gzip" : "", GP_VERSION, GP_RENDER_REVISION);
+}
+
+int gp_render_not_modified(const gp_request *req, const char *etag)
+{
+    const char *header = gp_request_header(req, "If-None-Match");
+    if (!header)
+        return 0;
+    size_t n = strlen(etag);
+    for (const char *p = header; *p;) {
+        while (*p == ' ' || *p == ',')
+            p++;
+        if (*p == '*')
+            return 1;
+        if (strncmp(p, "W/", 2) == 0)
+            p += 2;
+        if (*p != '"')
+            break; /* not an entity tag: nothing further can be read as one */
+        const char *close = strchr(p + 1, '"');
+        if (!close)
+            break;
+        if ((size_t)(close + 1 - p) == n && strncmp(p, etag, n) == 0)
+            return 1;
+        p = close + 1;
     }
-    return rc;
+    return 0;
 }

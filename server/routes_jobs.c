@@ -163,14 +163,30 @@ static int status_filter(const gp_request *req, unsigned *mask, gp_reply *reply)
     }
 }
 
+/* Reads ?cursor= (a token of a `next` link, cursor.h) into the position the page starts
+ * before; 0 when absent. Returns 0 or -1 with a 400. */
+static int page_cursor(const gp_request *req, int64_t *seq, gp_reply *reply)
+{
+    const char *text = gp_request_query(req, "cursor");
+    *seq = 0;
+    if (!text || gp_cursor_decode(&req->svc->cursor_keys, req->owner, text, seq) == 0)
+        return 0;
+    gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+               "cursor must be taken from the next link of a page this daemon gave you (a "
+               "cursor is valid for the key it was made for, until the daemon restarts); got "
+               "'%.40s': start again from the first page",
+               text);
+    return -1;
+}
+
 int gp_route_jobs(gp_request *req, gp_reply *reply)
 {
     gp_service *svc = req->svc;
-    long long limit = DEFAULT_LIMIT, cursor = 0;
+    long long limit = DEFAULT_LIMIT;
+    int64_t cursor = 0;
     unsigned mask;
     if (query_count(req, "limit", 1, MAX_LIMIT, &limit, reply) ||
-        query_count(req, "cursor", 1, INT64_MAX, &cursor, reply) ||
-        status_filter(req, &mask, reply))
+        page_cursor(req, &cursor, reply) || status_filter(req, &mask, reply))
         return GP_ROUTE_DONE;
     gp_job *jobs = malloc((size_t)limit * sizeof *jobs);
     if (!jobs) {
@@ -193,12 +209,14 @@ int gp_route_jobs(gp_request *req, gp_reply *reply)
         json_array_append_new(list, gp_job_status_info(&jobs[i]));
     /* the links repeat the query so that the next page keeps the filter */
     const char *status = gp_request_query(req, "status");
-    char self[160], next[200];
+    char self[160], next[160 + sizeof "&cursor=" + GP_CURSOR_CHARS];
     snprintf(self, sizeof self, "/jobs?limit=%lld%s%.60s", limit, status ? "&status=" : "",
              status ? status : "");
     json_t *links = json_pack("[{s:s, s:s, s:s}]", "href", self, "rel", "self", "type", JSON_TYPE);
     if (more && n > 0 && links) {
-        snprintf(next, sizeof next, "%s&cursor=%lld", self, (long long)jobs[n - 1].seq);
+        char token[GP_CURSOR_SIZE];
+        gp_cursor_encode(&svc->cursor_keys, req->owner, jobs[n - 1].seq, token);
+        snprintf(next, sizeof next, "%s&cursor=%s", self, token);
         json_array_append_new(links,
                               json_pack("{s:s, s:s, s:s}", "href", next, "rel", "next", "type", JSON_TYPE));
     }

@@ -126,6 +126,10 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     g.queue_depth = atomic_load(&svc->queued);
     g.workers = svc->cfg->workers;
     g.workers_busy = gp_pool_busy(svc->pool);
+    g.workers_abandoned = gp_pool_abandoned(svc->pool);
+    g.slow_heads = atomic_load(&svc->http.slow_heads);
+    g.connections = atomic_load(&svc->http.open);
+    g.polls_hung_up = gp_waiters_hung_up(svc->waiters);
     size_t len;
     char *text = gp_metrics_render(svc->metrics, &g, &len);
     if (!text) {

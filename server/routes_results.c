@@ -1,9 +1,11 @@
-/* routes_results.c - a finished job's result in the format asked for, and its
- * statistics with the stage timings. Both are rebuilt from the store on request. */
+/* routes_results.c - a finished job's result in the format asked for (streamed from the
+ * stored sections, gzip when asked, with a strong ETag), and its statistics with the stage
+ * timings (from the stored summary). Nothing is computed again. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "grainpack/io.h"
+#include "download.h"
 #include "problem.h"
 #include "render.h"
 #include "routes.h"
@@ -36,18 +38,29 @@ static int without_result(gp_request *req, gp_db *db, gp_reply *reply)
     return 1;
 }
 
-/* Loads the job's result; 1 with a problem in reply when there is none. */
-static int load(gp_request *req, gp_db *db, gp_spec *spec, gp_result *result, gp_reply *reply)
+/* Opens the job's stored result and parses its spec; 1 with a problem in reply when there
+ * is none. On 0 the caller frees res and spec. */
+static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp_reply *reply)
 {
+    gp_db *db = gp_store_acquire(req->svc->store, 1);
     if (!db) {
         gp_problem_store_unavailable(reply, req->path);
         return 1;
     }
-    if (without_result(req, db, reply))
+    int missing = without_result(req, db, reply), rc = 0;
+    if (!missing) {
+        rc = gp_store_open_result(db, req->id, req->owner, res);
+        if (rc == GP_SRV_ENOTFOUND) /* deleted between the two reads */
+            missing = without_result(req, db, reply);
+    }
+    gp_store_release(req->svc->store, db);
+    if (missing)
         return 1;
-    int rc = gp_render_load(db, req->id, req->owner, spec, result);
-    if (rc == GP_SRV_ENOTFOUND) /* deleted between the two reads */
-        return without_result(req, db, reply);
+    gp_error err;
+    /* accepted once, so parsed without today's caps */
+    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1};
+    if (rc == 0 && (rc = gp_spec_parse(res->spec_text, res->spec_len, &unlimited, spec, &err)))
+        gp_stored_result_free(res);
     if (rc == GP_ENOMEM) {
         gp_problem_out_of_memory(reply);
         return 1;
@@ -84,53 +97,66 @@ int gp_route_results(gp_request *req, gp_reply *reply)
     int color;
     if (gp_render_choose_format(req, &format, reply) || picture_color(req, &color, reply))
         return GP_ROUTE_DONE;
+    gp_stored_result res;
     gp_spec spec;
-    gp_result result;
-    gp_db *db = gp_store_acquire(req->svc->store, 1);
-    int missing = load(req, db, &spec, &result, reply);
-    gp_store_release(req->svc->store, db);
-    if (missing)
+    if (open_result(req, &res, &spec, reply))
         return GP_ROUTE_DONE;
-    if (color == GP_PICTURE_COLOR_QUALITY && !result.has_balance) {
+    if (color == GP_PICTURE_COLOR_QUALITY && !res.summary.has_balance) {
         gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
                    "color=quality colours the grains by F, which only a job that balances has; "
                    "job %s has no balance stage (color=radius)", req->id);
-        gp_result_free(&result);
+        gp_stored_result_free(&res);
         gp_spec_free(&spec);
         return GP_ROUTE_DONE;
     }
     if (color >= 0)
         spec.picture_color = (gp_picture_color)color;
-    char *body;
-    size_t len;
-    int rc = gp_render_format(&spec, &result, format, &body, &len);
-    if (rc == 0)
-        gp_reply_take(reply, 200, gp_format_media_type(format), body, len);
-    else if (rc == GP_ENOMEM)
-        gp_problem_out_of_memory(reply);
-    else
-        gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "rendering %s failed: %s",
-                   gp_format_name(format), gp_strerror(rc));
-    gp_result_free(&result);
-    gp_spec_free(&spec);
+    int gzip = gp_format_is_text(format) && gp_render_accepts_gzip(req);
+    char etag[GP_ETAG_SIZE];
+    gp_render_etag(&res, &spec, format, gzip, etag);
+    gp_reply_header_add(reply, "ETag", "%s", etag);
+    /* the bytes depend on Accept (the format, without ?f=) and Accept-Encoding */
+    gp_reply_header_add(reply, "Vary", "Accept, Accept-Encoding");
+    /* a result never changes but may be deleted, and is per key: ask again each time,
+     * which a 304 makes cheap */
+    gp_reply_header_add(reply, "Cache-Control", "private, no-cache");
+    if (gp_render_not_modified(req, etag)) {
+        gp_stored_result_free(&res);
+        gp_spec_free(&spec);
+        gp_reply_take(reply, 304, NULL, NULL, 0);
+        return GP_ROUTE_DONE;
+    }
+    gp_reply_header_add(reply, "Content-Disposition", "attachment; filename=\"job-%s.%s\"",
+                        req->id, gp_format_name(format));
+    if (gzip)
+        gp_reply_header_add(reply, "Content-Encoding", "gzip");
+    gp_body_stream *stream;
+    if (gp_download_new(req->svc, &res, &spec, format, gzip, &stream) == 0) {
+        gp_reply_stream(reply, 200, gp_format_media_type(format), stream);
+        /* libmicrohttpd 0.9.75 ends the headers of a HEAD answer to a chunked response with
+         * the last chunk ("0\r\n\r\n") although HEAD has no body: a client reusing the
+         * connection would read it as the next status line, so the connection closes */
+        reply->close = strcmp(req->method, "HEAD") == 0;
+    } else {
+        gp_problem_out_of_memory(reply); /* drops the headers above */
+    }
     return GP_ROUTE_DONE;
 }
 
 int gp_route_statistics(gp_request *req, gp_reply *reply)
 {
+    gp_stored_result res;
     gp_spec spec;
-    gp_result result;
+    if (open_result(req, &res, &spec, reply))
+        return GP_ROUTE_DONE;
     char names[GP_MAX_STAGES][32];
     double seconds[GP_MAX_STAGES];
     int ntimings = 0;
     gp_db *db = gp_store_acquire(req->svc->store, 1);
-    int missing = load(req, db, &spec, &result, reply);
-    if (!missing)
+    if (db)
         ntimings = gp_store_load_timings(db, req->id, names, seconds, GP_MAX_STAGES);
     gp_store_release(req->svc->store, db);
-    if (missing)
-        return GP_ROUTE_DONE;
-    json_t *stats = gp_statistics_json(&spec, &result);
+    json_t *stats = gp_statistics_json(&spec, &res.summary);
     json_t *timings = json_array();
     double total = 0.0;
     for (int i = 0; timings && i < ntimings; i++) {
@@ -146,7 +172,7 @@ int gp_route_statistics(gp_request *req, gp_reply *reply)
         json_decref(timings);
     }
     gp_reply_json(reply, 200, JSON_TYPE, stats);
-    gp_result_free(&result);
+    gp_stored_result_free(&res);
     gp_spec_free(&spec);
     return GP_ROUTE_DONE;
 }

@@ -43,30 +43,12 @@ static const gp_embedded_file *find_file(const char *name)
     return NULL;
 }
 
-/* Whether If-None-Match names `etag` (or is "*"): the client's copy is current. */
-static int not_modified(const gp_request *req, const char *etag)
-{
-    const char *inm = gp_request_header(req, "If-None-Match");
-    if (!inm)
-        return 0;
-    size_t n = strlen(etag);
-    for (const char *p = inm; *p;) {
-        p += strspn(p, " ,\t");
-        if (strncmp(p, "W/", 2) == 0) /* a weak match is enough for a GET (RFC 9110 13.1.2) */
-            p += 2;
-        if (*p == '*' || (strncmp(p, etag, n) == 0 && (p[n] == '\0' || strchr(" ,\t", p[n]))))
-            return 1;
-        p += strcspn(p, ",");
-    }
-    return 0;
-}
-
 static int serve(gp_request *req, gp_reply *reply, const gp_embedded_file *f)
 {
     reply->etag = f->etag;
     reply->cache_control = WEB_CACHE_CONTROL;
     reply->csp = PAGE_CSP;
-    if (not_modified(req, f->etag)) {
+    if (gp_render_not_modified(req, f->etag)) { /* the client's copy is current */
         reply->status = 304;
         return GP_ROUTE_DONE;
     }

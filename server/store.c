@@ -46,25 +46,33 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                   " grain_fraction = ?6, r_min = ?7, r_max = ?8, r_mean = ?9, chi2 = ?10,"
                   " dof = ?11, p_value = ?12, max_abs_z = ?13, initial_disks = ?14,"
                   " front_attempts = ?15, front_closures = ?16, front_frozen = ?17,"
-                  " front_capped = ?18, max_level = ?19"
+                  " front_capped = ?18, max_level = ?19, result_version = ?20"
                   " WHERE id = ?1 AND status = 'running'",
-    [ST_RESULT] = "INSERT OR REPLACE INTO results (job_id, count, disks) VALUES (?1, ?2, ?3)",
+    [ST_SECTION] = "INSERT INTO result_sections (job_id, tag, version, bytes, summary)"
+                   " VALUES (?1, ?2, ?3, ?4, ?5) RETURNING id",
+    [ST_CHUNK] = "INSERT INTO result_chunks (section, chunk, data) VALUES (?1, ?2, ?3)",
     [ST_BIN] = "INSERT OR REPLACE INTO bin_stats (job_id, bin, min, max, target, achieved, count, z)"
                " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
     [ST_TIMING] = "INSERT OR REPLACE INTO stage_timings (job_id, position, stage, seconds)"
                   " VALUES (?1, ?2, ?3, ?4)",
     [ST_FAIL] = "UPDATE jobs SET status = 'failed', error = ?2, message = ?3, finished = ?4,"
                 " updated = ?4 WHERE id = ?1 AND status = 'running'",
+    /* a stop that cancelled the job cleanly: its claim does not count (--max-job-attempts
+     * counts the runs the daemon died in) */
     [ST_REQUEUE] = "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
-                   " message = ?2, updated = ?3 WHERE id = ?1 AND status = 'running'",
+                   " message = ?2, updated = ?3, claims = max(claims - 1, 0)"
+                   " WHERE id = ?1 AND status = 'running'",
     [ST_STATUS] = "SELECT status FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
     [ST_DISMISS] = "UPDATE jobs SET status = 'dismissed', message = ?2, finished = ?3, updated = ?3"
                    " WHERE id = ?1 AND status IN ('accepted', 'running')",
     [ST_DELETE] = "DELETE FROM jobs WHERE id = ?1",
-    [ST_LOAD] = "SELECT j.spec, r.count, r.disks, j.initial_disks, j.front_attempts,"
-                " j.front_closures, j.front_frozen, j.front_capped, j.max_level"
-                " FROM jobs j JOIN results r ON r.job_id = j.id"
-                " WHERE j.id = ?1 AND j.status = 'successful' AND (?2 IS NULL OR j.owner = ?2)",
+    [ST_OPEN_RESULT] = "SELECT seq, spec, result_version FROM jobs"
+                       " WHERE id = ?1 AND status = 'successful' AND (?2 IS NULL OR owner = ?2)",
+    [ST_SUMMARY_SECTIONS] = "SELECT tag, version, id, bytes FROM result_sections"
+                            " WHERE job_id = ?1 AND summary = 1 ORDER BY id",
+    [ST_FIND_SECTION] = "SELECT s.id, s.bytes FROM result_sections s JOIN jobs j ON j.id = s.job_id"
+                        " WHERE j.seq = ?1 AND s.tag = ?2",
+    [ST_READ_CHUNK] = "SELECT data FROM result_chunks WHERE section = ?1 AND chunk = ?2",
     [ST_TIMINGS] = "SELECT stage, seconds FROM stage_timings WHERE job_id = ?1 ORDER BY position",
     [ST_COUNT] = "SELECT status, count(*) FROM jobs GROUP BY status",
     [ST_ACTIVE] = "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('accepted', 'running')",
@@ -295,6 +303,7 @@ static int migrate(gp_db *db, char *why, size_t why_size)
         char set_version[48];
         snprintf(set_version, sizeof set_version, "PRAGMA user_version = %d", version + 1);
         if (exec_sql(db->conn, gp_store_migrations[version], why, why_size) ||
+            (gp_store_conversions[version] && gp_store_conversions[version](db, why, why_size)) ||
             exec_sql(db->conn, set_version, why, why_size) ||
             exec_sql(db->conn, "COMMIT", why, why_size)) {
             char ignored[8];
@@ -305,24 +314,38 @@ static int migrate(gp_db *db, char *why, size_t why_size)
     }
 }
 
-static int requeue_running(gp_db *db, int *requeued, char *why, size_t why_size)
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up)
 {
-    char now[GP_TIMESTAMP_SIZE], sql[320];
+    /* a job still running in the store was running when the daemon died: its claims
+     * count the starts it did not survive (a clean stop gives its claim back) */
+    char now[GP_TIMESTAMP_SIZE], fail[512], requeue[320];
     gp_timestamp_now(now);
-    snprintf(sql, sizeof sql,
+    snprintf(fail, sizeof fail,
+             "UPDATE jobs SET status = 'failed', error = 'gave up', finished = '%s',"
+             " updated = '%s', message = 'failed: the daemon stopped ' || claims ||"
+             " ' times while this job ran (a crash, a kill, or a stop it did not answer"
+             " in time); it is not run again (--max-job-attempts %d)'"
+             " WHERE status = 'running' AND claims >= %d",
+             now, now, max_attempts, max_attempts);
+    snprintf(requeue, sizeof requeue,
              "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
              " message = '" GP_REQUEUE_MESSAGE "', updated = '%s'"
              " WHERE status = 'running'",
              now);
-    if (exec_sql(db->conn, "BEGIN IMMEDIATE", why, why_size) ||
-        exec_sql(db->conn, sql, why, why_size))
-        return GP_SRV_EDB;
-    int n = sqlite3_changes(db->conn);
-    if (exec_sql(db->conn, "COMMIT", why, why_size))
-        return GP_SRV_EDB;
-    if (requeued)
-        *requeued = n;
-    return 0;
+    int rc = gp_db_run(db, db->begin, "begin immediate");
+    if (rc)
+        return rc;
+    char *msg = NULL;
+    if (sqlite3_exec(db->conn, fail, NULL, NULL, &msg) != SQLITE_OK)
+        goto failed;
+    *given_up = sqlite3_changes(db->conn);
+    if (sqlite3_exec(db->conn, requeue, NULL, NULL, &msg) != SQLITE_OK)
+        goto failed;
+    *requeued = sqlite3_changes(db->conn);
+    return gp_db_end(db, 0);
+failed:
+    sqlite3_free(msg);
+    return gp_db_end(db, gp_db_fail(db, "recover running jobs"));
 }
 
 /* Adds db to the list of connections closed with the store. */
@@ -340,7 +363,7 @@ static int remember(gp_store *store, gp_db *db)
     return 0;
 }
 
-int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size)
+int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size)
 {
     *out = NULL;
     gp_store *store = calloc(1, sizeof *store);
@@ -354,8 +377,6 @@ int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, si
     if (db)
         db->store = store;
     int rc = db ? migrate(db, why, why_size) : GP_SRV_EDB;
-    if (rc == 0)
-        rc = requeue_running(db, requeued, why, why_size);
     if (rc == 0)
         rc = remember(store, db);
     if (rc) {

@@ -7,6 +7,7 @@
 #ifndef GRAINPACKD_STORE_H
 #define GRAINPACKD_STORE_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -29,7 +30,7 @@ enum {
 const char *gp_srv_strerror(int code);
 
 /* The schema version this build migrates to (PRAGMA user_version). */
-#define GP_STORE_SCHEMA_VERSION 2
+#define GP_STORE_SCHEMA_VERSION 3
 
 typedef enum gp_job_status {
     GP_JOB_ACCEPTED = 0,
@@ -63,11 +64,16 @@ typedef struct gp_job {
 typedef struct gp_store gp_store;
 typedef struct gp_db gp_db;
 
-/* Opens (creating if needed) the database at path, migrates it to the current schema and
- * queues again the jobs a crash left running (their count in *requeued, may be NULL).
+/* Opens (creating if needed) the database at path and migrates it to the current schema.
  * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why. The caller owns *out
  * (gp_store_close). */
-int gp_store_open(const char *path, gp_store **out, int *requeued, char *why, size_t why_size);
+int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size);
+
+/* At start, the jobs a previous run left running (it died: a crash, a kill, a stop that
+ * gave up on a worker): those started max_attempts times or more (their claims; a clean
+ * stop gives its claim back) fail with a message that says why (*given_up counts them),
+ * the others are queued again (*requeued). Returns 0 or a write failure. */
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up);
 
 /* Closes every connection. All gp_db must have been released. */
 void gp_store_close(gp_store *store);
@@ -108,9 +114,13 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
                        size_t limit, gp_job *out, size_t *n, int *more);
 
 /* Claims the oldest accepted job atomically (UPDATE ... RETURNING): it becomes running.
- * Returns 0 with the id and a malloc'd copy of its spec text (caller frees), or
- * GP_SRV_ENOTFOUND when none waits, or GP_SRV_EDB. */
-int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len);
+ * *queued (the caller's count of accepted jobs; may be NULL) is decremented before the
+ * claim commits and given back if the commit fails, so that whoever sees the job running
+ * sees it out of the queue (the --max-queued admission reads that count). Returns 0
+ * with the id and a malloc'd copy of its spec text (caller frees), or GP_SRV_ENOTFOUND
+ * when none waits, or GP_SRV_EDB. */
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len);
 
 /* Records the progress of a running job (no-op when it is no longer running). */
 int gp_store_progress(gp_db *db, const char *id, int percent, const char *message);
@@ -134,11 +144,45 @@ int gp_store_requeue(gp_db *db, const char *id);
 int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
                      int *deleted, gp_job *after);
 
-/* What is needed to render a successful job's result again: the spec text (malloc'd,
- * caller frees) and the packing with its front diagnostics (free with gp_packing_free).
- * Returns 0, GP_SRV_ENOTFOUND (no such job or no result) or GP_SRV_EDB/GP_ENOMEM. */
-int gp_store_load_result(gp_db *db, const char *id, const char *owner, char **spec_text,
-                         size_t *spec_len, gp_packing *packing);
+/* A successful job's stored result, opened for rendering: its spec, its summary (the
+ * statistics and every figure but the per-grain arrays, which gp_result_reader reads piece
+ * by piece), and what identifies its stored bytes. */
+typedef struct gp_stored_result {
+    int64_t key;            /* the store's own handle of the result, for gp_result_reader */
+    char *spec_text;        /* owned, NUL-terminated: the spec as submitted */
+    size_t spec_len;
+    gp_result summary;      /* owned (gp_result_free): per-grain arrays NULL */
+    char version[40];       /* changes whenever the stored bytes could (a strong ETag's root) */
+} gp_stored_result;
+
+/* Opens the result of a successful job of `owner`: reads the spec and the summary
+ * sections. Returns 0 with *out filled (free with gp_stored_result_free), GP_SRV_ENOTFOUND
+ * (no such job, not successful, or deleted meanwhile), GP_SRV_EDB (also for a result whose
+ * sections cannot be decoded: logged) or GP_ENOMEM. */
+int gp_store_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out);
+void gp_stored_result_free(gp_stored_result *r);
+
+/* Reading the per-grain sections of one opened result, piece by piece, for one download.
+ * Every read is its own short read transaction: a slow client holds none between two
+ * pieces, so WAL checkpoints go on. The reader keeps the last chunk it read of each
+ * section (GP_STORE_CHUNK bytes at most each), so the small reads of a writer's windows
+ * cost one query per chunk. */
+typedef struct gp_result_reader gp_result_reader;
+
+/* The size of the pieces a result's sections are stored in. Why this value: large enough
+ * that a 10^6-grain result is some 2500 rows (one query each when read in order), small
+ * enough that a reader's cache of one chunk per section stays a few hundred kilobytes. */
+#define GP_STORE_CHUNK ((size_t)64 * 1024)
+
+/* A reader of the result `key` (gp_stored_result.key); NULL when out of memory. */
+gp_result_reader *gp_result_reader_new(int64_t key);
+
+/* Reads `len` bytes of section `tag` from `offset` into dst through db (a connection the
+ * caller holds for the call). Returns 0, GP_SRV_ENOTFOUND (the result was deleted
+ * meanwhile, or the section is shorter), GP_SRV_EDB or GP_ENOMEM. */
+int gp_result_reader_read(gp_result_reader *r, gp_db *db, const char *tag, uint64_t offset,
+                          void *dst, size_t len);
+void gp_result_reader_free(gp_result_reader *r);
 
 /* The stage timings of a job, in the order the stages ran (at most cap; stage names are
  * copied into names[i], 32 bytes each). Returns the count or a negative code. */

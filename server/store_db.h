@@ -14,7 +14,8 @@ enum stmt_id {
     ST_CLAIM,
     ST_PROGRESS,
     ST_FINISH,
-    ST_RESULT,
+    ST_SECTION,
+    ST_CHUNK,
     ST_BIN,
     ST_TIMING,
     ST_FAIL,
@@ -22,7 +23,10 @@ enum stmt_id {
     ST_STATUS,
     ST_DISMISS,
     ST_DELETE,
-    ST_LOAD,
+    ST_OPEN_RESULT,
+    ST_SUMMARY_SECTIONS,
+    ST_FIND_SECTION,
+    ST_READ_CHUNK,
     ST_TIMINGS,
     ST_COUNT,
     ST_ACTIVE,
@@ -76,6 +80,16 @@ int gp_db_run_one(gp_db *db, sqlite3_stmt *s, const char *what);
 /* Ends the transaction of gp_db_write: rc 0 commits (0, or the commit's failure class,
  * rolled back), any other rc rolls back. Returns the outcome. */
 int gp_db_end(gp_db *db, int rc);
+
+/* Writes the sections of a successful job's result (sections.h), chunk by chunk, inside
+ * the caller's transaction. Returns 0, GP_ENOMEM or a class of gp_db_fail. */
+int gp_db_write_sections(gp_db *db, const char *id, const gp_result *result);
+
+/* Fills buf with len bytes from the kernel's random source. */
+void gp_db_random_bytes(void *buf, size_t len);
+
+/* A new random version of a job's stored result: 32 hex digits and a NUL. */
+void gp_db_new_result_version(char out[33]);
 
 /* Copies the text of column col (empty when NULL) into dst, truncated to size. */
 void gp_db_copy_text(char *dst, size_t size, sqlite3_stmt *s, int col);

@@ -28,16 +28,21 @@ int gp_job_status_parse(const char *name, gp_job_status *out)
     return GP_EINVAL;
 }
 
+void gp_db_random_bytes(void *buf, size_t len)
+{
+    size_t got = 0;
+    while (got < len) {
+        ssize_t n = getrandom((unsigned char *)buf + got, len - got, 0);
+        if (n > 0)
+            got += (size_t)n;
+    }
+}
+
 /* A random (version 4) UUID: job ids must not be guessable from one another. */
 static void new_job_id(char out[GP_JOB_ID_SIZE])
 {
     unsigned char b[16];
-    size_t got = 0;
-    while (got < sizeof b) {
-        ssize_t n = getrandom(b + got, sizeof b - got, 0);
-        if (n > 0)
-            got += (size_t)n;
-    }
+    gp_db_random_bytes(b, sizeof b);
     b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
     b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
     snprintf(out, GP_JOB_ID_SIZE,
@@ -163,7 +168,8 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
     return rc == SQLITE_ROW || rc == SQLITE_DONE ? 0 : gp_db_fail(db, "list jobs");
 }
 
-int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t *spec_len)
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len)
 {
     *spec_text = NULL;
     *spec_len = 0;
@@ -194,7 +200,12 @@ int gp_store_claim(gp_db *db, char id[GP_JOB_ID_SIZE], char **spec_text, size_t 
     if (rc != SQLITE_DONE && rc != SQLITE_ROW)
         result = gp_db_fail(db, "claim");
     sqlite3_reset(s);
+    int claimed = result == 0;
+    if (claimed && queued)
+        atomic_fetch_sub(queued, 1);
     result = gp_db_end(db, result);
+    if (claimed && result && queued)
+        atomic_fetch_add(queued, 1);
     if (result && result != GP_SRV_ENOTFOUND) {
         free(*spec_text);
         *spec_text = NULL;

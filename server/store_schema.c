@@ -54,5 +54,31 @@ static const char migration_2[] =
     "ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';"
     "CREATE INDEX jobs_by_owner ON jobs (owner, status, seq);";
 
-const char *const gp_store_migrations[] = {migration_1, migration_2};
+/* Version 3: a result is what every stage produced, as tagged binary sections
+ * (grainpack/sections.h: the packing's statistics, the disks, the balancing run and F, the
+ * cells and their statistics; a mesh stage adds its own tags), each cut in chunks of
+ * GP_STORE_CHUNK bytes so that a download reads it piece by piece, one short query per
+ * chunk. A download renders these; nothing is derived again. `summary` marks the small
+ * sections a result's statistics are decoded from. result_version changes whenever a
+ * job's stored result is written (the root of its downloads' ETags). Version 2's
+ * `results` (the disks alone) is converted by store_upgrade.c, then dropped. */
+static const char migration_3[] =
+    "CREATE TABLE result_sections ("
+    "  id INTEGER PRIMARY KEY AUTOINCREMENT," /* never reused: a reader's handle stays true */
+    "  job_id TEXT NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
+    "  tag TEXT NOT NULL,"                     /* 'disks', 'F', 'cell_xy', ... */
+    "  version INTEGER NOT NULL,"              /* of the section's layout */
+    "  bytes INTEGER NOT NULL,"
+    "  summary INTEGER NOT NULL,"
+    "  UNIQUE (job_id, tag));"
+    "CREATE TABLE result_chunks ("
+    "  section INTEGER NOT NULL REFERENCES result_sections (id) ON DELETE CASCADE,"
+    "  chunk INTEGER NOT NULL,"                /* bytes chunk * GP_STORE_CHUNK onwards */
+    "  data BLOB NOT NULL,"
+    "  PRIMARY KEY (section, chunk));"
+    "ALTER TABLE jobs ADD COLUMN result_version TEXT;";
+
+const char *const gp_store_migrations[] = {migration_1, migration_2, migration_3};
+int (*const gp_store_conversions[])(gp_db *db, char *why, size_t why_size) = {NULL, NULL,
+                                                                             gp_store_upgrade_v3};
 const size_t gp_store_migration_count = sizeof gp_store_migrations / sizeof gp_store_migrations[0];

@@ -1,11 +1,17 @@
-/* waiters.c - suspended long-poll requests and the thread that expires them. */
+/* waiters.c - suspended long-poll requests and the thread that expires them, and that
+ * sees their clients hang up. */
+#define _GNU_SOURCE /* POLLRDHUP */
 #include "waiters.h"
 
+#include <poll.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/eventfd.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "grainpack/error.h"
 #include "log.h"
@@ -16,6 +22,8 @@
 
 struct gp_waiter {
     void *conn;
+    int fd;          /* the connection's socket, watched for the client's hang-up */
+    uint64_t serial; /* tells this entry from a later one at the same address */
     char job_id[GP_JOB_ID_SIZE];
     double deadline;
     int suspended; /* the connection is suspended: whoever releases the entry resumes it */
@@ -24,12 +32,18 @@ struct gp_waiter {
 };
 
 struct gp_waiters {
-    pthread_mutex_t lock; /* guards head, stopping; held around suspend/resume */
-    pthread_cond_t changed;
+    pthread_mutex_t lock; /* guards head, stopping, closed; held around suspend/resume */
     gp_waiter *head;
     const gp_suspender *how;
     int stopping;
+    int wake_fd;     /* an eventfd: written when the thread must look again (a new
+                        suspension, a stop) */
+    uint64_t serial; /* of the last entry */
+    unsigned long hung_up; /* waits ended because the client closed its connection */
     pthread_t thread;
+    struct pollfd *fds; /* the thread's: the wake_fd, then the sockets of the suspended */
+    uint64_t *serials;  /* the entry of each socket in fds */
+    size_t cap;
 };
 
 /* Unlinks e (lock held), resumes it if suspended, frees it. An entry that is not
@@ -48,6 +62,65 @@ static void release(gp_waiters *w, gp_waiter *e)
     free(e);
 }
 
+/* Wakes the deadline thread (a suspension, a stop). */
+static void nudge(gp_waiters *w)
+{
+    uint64_t one = 1;
+    if (write(w->wake_fd, &one, sizeof one) < 0) {
+        /* the counter is full: the thread is due to wake anyway */
+    }
+}
+
+/* The list of sockets to watch (lock held): the wake_fd first, then each suspended
+ * connection's, for its hang-up only (POLLRDHUP; a client that sends more, a pipelined
+ * request, is not a hang-up and must not wake the thread again and again). Returns how
+ * many, 1 when out of memory (then only deadlines and nudges count). */
+static size_t watch_list(gp_waiters *w)
+{
+    size_t n = 1;
+    for (gp_waiter *e = w->head; e; e = e->next)
+        n += e->suspended && e->fd >= 0;
+    if (n > w->cap) {
+        struct pollfd *fds = realloc(w->fds, n * sizeof *fds);
+        if (fds)
+            w->fds = fds;
+        uint64_t *serials = realloc(w->serials, n * sizeof *serials);
+        if (serials)
+            w->serials = serials;
+        if (!fds || !serials)
+            return 1;
+        w->cap = n;
+    }
+    n = 1;
+    for (gp_waiter *e = w->head; e; e = e->next) {
+        if (e->suspended && e->fd >= 0) {
+            w->fds[n] = (struct pollfd){e->fd, POLLRDHUP, 0};
+            w->serials[n++] = e->serial;
+        }
+    }
+    return n;
+}
+
+/* Releases the entries whose client hung up (lock held): resumed, libmicrohttpd finds the
+ * socket closed and frees the connection, and with it its place in the connection
+ * limits, at once rather than at the end of the wait. */
+static void release_hung_up(gp_waiters *w, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        if (!(w->fds[i].revents & (POLLRDHUP | POLLHUP | POLLERR | POLLNVAL)))
+            continue;
+        for (gp_waiter *e = w->head; e; e = e->next) {
+            if (e->serial == w->serials[i]) {
+                if (e->suspended) {
+                    w->hung_up++;
+                    release(w, e);
+                }
+                break;
+            }
+        }
+    }
+}
+
 static void *deadline_thread(void *arg)
 {
     gp_waiters *w = arg;
@@ -61,16 +134,18 @@ static void *deadline_thread(void *arg)
             else if (e->deadline < next)
                 next = e->deadline;
         }
-        /* condition variables wait on the realtime clock: convert the interval */
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        double wait = next - now;
-        if (wait < 0.001)
-            wait = 0.001;
-        long long ns = ts.tv_nsec + (long long)(wait * 1e9);
-        ts.tv_sec += (time_t)(ns / 1000000000);
-        ts.tv_nsec = (long)(ns % 1000000000);
-        pthread_cond_timedwait(&w->changed, &w->lock, &ts);
+        size_t n = watch_list(w);
+        w->fds[0] = (struct pollfd){w->wake_fd, POLLIN, 0};
+        pthread_mutex_unlock(&w->lock);
+        int ms = (int)((next - now) * 1e3) + 1;
+        if (poll(w->fds, n, ms < 1 ? 1 : ms) > 0 && (w->fds[0].revents & POLLIN)) {
+            uint64_t count;
+            if (read(w->wake_fd, &count, sizeof count) < 0) {
+                /* nothing was pending after all */
+            }
+        }
+        pthread_mutex_lock(&w->lock);
+        release_hung_up(w, n);
     }
     pthread_mutex_unlock(&w->lock);
     return NULL;
@@ -83,15 +158,30 @@ int gp_waiters_start(gp_waiters **out, const gp_suspender *how)
         return GP_ENOMEM;
     w->how = how;
     pthread_mutex_init(&w->lock, NULL);
-    pthread_cond_init(&w->changed, NULL);
-    if (pthread_create(&w->thread, NULL, deadline_thread, w)) {
-        pthread_cond_destroy(&w->changed);
+    w->fds = malloc(sizeof *w->fds);
+    w->serials = malloc(sizeof *w->serials);
+    w->cap = 1;
+    w->wake_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (!w->fds || !w->serials || w->wake_fd < 0 ||
+        pthread_create(&w->thread, NULL, deadline_thread, w)) {
+        if (w->wake_fd >= 0)
+            close(w->wake_fd);
+        free(w->fds);
+        free(w->serials);
         pthread_mutex_destroy(&w->lock);
         free(w);
         return GP_ENOMEM;
     }
     *out = w;
     return 0;
+}
+
+unsigned long gp_waiters_hung_up(gp_waiters *w)
+{
+    pthread_mutex_lock(&w->lock);
+    unsigned long n = w->hung_up;
+    pthread_mutex_unlock(&w->lock);
+    return n;
 }
 
 /* Wakes e (lock held): resumed now if suspended, else marked for its handler. */
@@ -113,7 +203,7 @@ void gp_waiters_stop(gp_waiters *w)
         after = e->next;
         wake(w, e);
     }
-    pthread_cond_signal(&w->changed);
+    nudge(w);
     pthread_mutex_unlock(&w->lock);
     pthread_join(w->thread, NULL);
 }
@@ -127,7 +217,9 @@ void gp_waiters_free(gp_waiters *w)
         w->head = e->next;
         free(e);
     }
-    pthread_cond_destroy(&w->changed);
+    close(w->wake_fd);
+    free(w->fds);
+    free(w->serials);
     pthread_mutex_destroy(&w->lock);
     free(w);
 }
@@ -139,6 +231,7 @@ gp_waiter *gp_waiters_add(gp_waiters *w, void *conn, const char *job_id, double 
         return NULL;
     e->conn = conn;
     e->deadline = deadline;
+    e->fd = w->how->socket(conn);
     snprintf(e->job_id, sizeof e->job_id, "%s", job_id);
     pthread_mutex_lock(&w->lock);
     if (w->stopping) {
@@ -146,6 +239,7 @@ gp_waiter *gp_waiters_add(gp_waiters *w, void *conn, const char *job_id, double 
         free(e);
         return NULL;
     }
+    e->serial = ++w->serial;
     e->next = w->head;
     w->head = e;
     pthread_mutex_unlock(&w->lock);
@@ -159,7 +253,7 @@ int gp_waiters_suspend(gp_waiters *w, gp_waiter *entry)
     if (suspend) {
         w->how->suspend(entry->conn);
         entry->suspended = 1;
-        pthread_cond_signal(&w->changed); /* the deadline thread may need to wake sooner */
+        nudge(w); /* the deadline thread watches its socket, and may need to wake sooner */
     } else {
         release(w, entry);
     }

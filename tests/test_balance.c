@@ -22,8 +22,8 @@ static void quality_of(const gp_domain *dom, const gp_disk *d, size_t n, double 
 {
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(d, n, &rt, &err) == 0);
-    CHECK(gp_quality(dom, rt, d, n, F, q, &err) == 0);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    CHECK(gp_quality(dom, rt, d, n, F, q, NULL, &err) == 0);
     gp_rt_free(rt);
 }
 
@@ -125,7 +125,7 @@ static summary check_balance(const gp_spec *spec, uint64_t seed, gp_balance_meth
     gp_disk *before = malloc(pk.count * sizeof *before);
     memcpy(before, pk.disks, pk.count * sizeof *before);
     gp_rt *rt;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     gp_balance_params bp = {method, 0, 0.0, GP_RT_UPDATE_FLIPS};
     gp_balance_result br;
     int rc = gp_balance(&spec->domain, pk.disks, pk.count, rt, &bp, NULL, &br, &err);
@@ -157,8 +157,8 @@ static summary check_balance(const gp_spec *spec, uint64_t seed, gp_balance_meth
         gp_quality_stats fresh;
         gp_rt *rt2;
         double *F = malloc(pk.count * sizeof *F);
-        CHECK(gp_rt_build(pk.disks, pk.count, &rt2, &err) == 0);
-        CHECK(gp_quality(&spec->domain, rt2, pk.disks, pk.count, F, &fresh, &err) == 0);
+        CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt2, &err) == 0);
+        CHECK(gp_quality(&spec->domain, rt2, pk.disks, pk.count, F, &fresh, NULL, &err) == 0);
         CHECK_MSG(memcmp(&fresh, &br.after, sizeof fresh) == 0 && memcmp(F, br.F, pk.count * sizeof *F) == 0,
                   "%s seed %llu: F of a fresh triangulation %.6f/%.6f vs %.6f/%.6f", label,
                   (unsigned long long)seed, fresh.max, fresh.mean, br.after.max, br.after.mean);
@@ -248,7 +248,7 @@ static void test_method_none_measures_without_moving(void)
     gp_disk *copy = malloc(pk.count * sizeof *copy);
     memcpy(copy, pk.disks, pk.count * sizeof *copy);
     gp_rt *rt;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     gp_balance_params bp = {GP_BALANCE_NONE, 0, 0.0, GP_RT_UPDATE_FLIPS};
     gp_balance_result br;
     CHECK(gp_balance(&spec.domain, pk.disks, pk.count, rt, &bp, NULL, &br, &err) == 0);
@@ -277,7 +277,7 @@ static void test_flips_and_rebuilds_give_the_same_structure(void)
     pack_seed(&spec, 2, &b);
     gp_rt *ra, *rb;
     gp_error err;
-    CHECK(gp_rt_build(a.disks, a.count, &ra, &err) == 0 && gp_rt_build(b.disks, b.count, &rb, &err) == 0);
+    CHECK(gp_rt_build(a.disks, a.count, NULL, &ra, &err) == 0 && gp_rt_build(b.disks, b.count, NULL, &rb, &err) == 0);
     gp_balance_params flips = {GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_FLIPS};
     gp_balance_params rebuild = {GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_REBUILD};
     gp_balance_result fa, fb;
@@ -310,7 +310,7 @@ static void test_progress_rises_to_one_and_cancel_stops(void)
     gp_error err;
     pack_seed(&spec, 1, &pk);
     gp_rt *rt;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     gp_balance_params bp = {GP_BALANCE_RELOCATION, 5, 0.0, GP_RT_UPDATE_REBUILD};
     double last = 0.0;
     gp_progress progress = {record_progress, &last, NULL};
@@ -325,6 +325,26 @@ static void test_progress_rises_to_one_and_cancel_stops(void)
     gp_progress cancelled = {NULL, NULL, &cancel};
     CHECK(gp_balance(&spec.domain, pk.disks, pk.count, rt, &bp, &cancelled, &br, &err) == GP_ECANCELED);
     CHECK(br.F == NULL);
+    gp_rt_free(rt);
+    /* measuring F alone stops too, once it has more centres than one check's worth */
+    gp_packing many;
+    gp_spec_free(&spec);
+    load_example("bagi", &spec);
+    pack_seed(&spec, 1, &many);
+    CHECK(many.count > GP_QUALITY_CENTRES_PER_CHECK);
+    CHECK(gp_rt_build(many.disks, many.count, NULL, &rt, &err) == 0);
+    gp_quality_stats q;
+    CHECK(gp_quality(&spec.domain, rt, many.disks, many.count, NULL, &q, &cancel, &err) == GP_ECANCELED);
+    CHECK(gp_quality(&spec.domain, rt, many.disks, many.count, NULL, &q, NULL, &err) == 0 && q.interior > 0);
+    /* and balancing them stops before its first sweep, while it reads the rings and
+     * measures F: not one centre has moved (the sweep's first check would come only after
+     * GP_QUALITY_CENTRES_PER_CHECK centres had been tried) */
+    gp_disk *before = malloc(many.count * sizeof *before);
+    memcpy(before, many.disks, many.count * sizeof *before);
+    CHECK(gp_balance(&spec.domain, many.disks, many.count, rt, &bp, &cancelled, &br, &err) == GP_ECANCELED);
+    CHECK(br.F == NULL && memcmp(before, many.disks, many.count * sizeof *before) == 0);
+    free(before);
+    gp_packing_free(&many);
     gp_rt_free(rt);
     gp_packing_free(&pk);
     gp_spec_free(&spec);

@@ -12,6 +12,7 @@
 #include "check.h"
 #include "grainpack/balance.h"
 #include "grainpack/io.h"
+#include "render_checks.h"
 #include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
 #include "packing_checks.h"
@@ -260,7 +261,7 @@ static void check_structure(const char *label, gp_spec *spec, const gp_disk *d, 
 {
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(d, n, &rt, &err) == 0);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     gp_cells plain, shrunk;
     gp_laguerre_params none = {GP_SHRINK_NONE, 0};
     CHECK(gp_laguerre(&spec->domain, d, n, rt, &none, NULL, &plain, &err) == 0);
@@ -294,7 +295,7 @@ static void test_cells_keep_every_promise_on_the_reference_cases(void)
             if (seed == 1 && c < 3) {
                 /* and once balanced, as the report builds its figures */
                 gp_rt *rt;
-                CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+                CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
                 gp_balance_params bp = {GP_BALANCE_RELOCATION, 0, 0.0, GP_RT_UPDATE_FLIPS};
                 gp_balance_result br;
                 CHECK(gp_balance(&spec.domain, pk.disks, pk.count, rt, &bp, NULL, &br, &err) == 0);
@@ -322,7 +323,7 @@ static void test_flush_boundary_keeps_cells_on_the_walls(void)
     gp_error err;
     pack_seed(&spec, 1, &pk);
     gp_rt *rt;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     gp_cells c;
     spec.laguerre = (gp_laguerre_params){GP_SHRINK_OFFSET, 1};
     CHECK(gp_laguerre(&spec.domain, pk.disks, pk.count, rt, &spec.laguerre, NULL, &c, &err) == 0);
@@ -413,12 +414,7 @@ static size_t read_vtk(char *text, const gp_disk *d, size_t n)
 
 static char *render(gp_format format, const gp_spec *spec, const gp_result *r)
 {
-    char *buf = NULL;
-    size_t len;
-    FILE *f = open_memstream(&buf, &len);
-    CHECK(gp_write_result(f, format, spec, r) == 0);
-    fclose(f);
-    return buf;
+    return render_text(format, spec, r, NULL);
 }
 
 static void test_vtk_and_json_carry_every_cell(void)
@@ -509,7 +505,7 @@ static void test_a_disk_outside_its_cell_is_a_geometry_error(void)
     for (int c = 0; c < 2; c++) {
         gp_rt *rt;
         gp_error err;
-        CHECK(gp_rt_build(cases[c], 3, &rt, &err) == 0);
+        CHECK(gp_rt_build(cases[c], 3, NULL, &rt, &err) == 0);
         gp_laguerre_params params = {GP_SHRINK_NONE, 0};
         gp_cells cells;
         CHECK(gp_laguerre(&dom, cases[c], 3, rt, &params, NULL, &cells, &err) == GP_EGEOM);
@@ -524,7 +520,7 @@ static void test_one_disk_owns_the_whole_domain(void)
     gp_disk one = {1, 1, 0.5, 0.8};
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(&one, 1, &rt, &err) == 0);
+    CHECK(gp_rt_build(&one, 1, NULL, &rt, &err) == 0);
     gp_laguerre_params params = {GP_SHRINK_OFFSET, 0};
     gp_cells c;
     CHECK(gp_laguerre(&dom, &one, 1, rt, &params, NULL, &c, &err) == 0);

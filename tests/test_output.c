@@ -10,15 +10,12 @@
 #include "grainpack/pipeline.h"
 #include "grainpack/stats.h"
 #include "packing_checks.h"
+#include "render_checks.h"
 
 /* Renders a result in a format into a malloc'd, NUL-terminated buffer. */
 static char *render(gp_format format, const gp_spec *spec, const gp_result *result, size_t *len)
 {
-    char *buf = NULL;
-    FILE *f = open_memstream(&buf, len);
-    CHECK(gp_write_result(f, format, spec, result) == 0);
-    fclose(f);
-    return buf;
+    return render_text(format, spec, result, len);
 }
 
 /* Loads examples/<name>.json and runs the pipeline on it. */

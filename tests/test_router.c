@@ -328,7 +328,7 @@ int main(void)
     char why[256];
     gp_log_silence(1);
     if (gp_config_load(&cfg, 3, argv, stdout, stderr) != 0 ||
-        gp_store_open(db_path, &svc.store, NULL, why, sizeof why) != 0 ||
+        gp_store_open(db_path, &svc.store, why, sizeof why) != 0 ||
         !(svc.metrics = gp_metrics_new())) {
         fprintf(stderr, "test_router: cannot set up the service\n");
         return 1;

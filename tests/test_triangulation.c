@@ -2,7 +2,8 @@
  * the hull where the header says, the empty-power-circle property checked by brute force,
  * hidden vertices reported, degenerate inputs, all the rings at once, and updates after
  * moves (flips, reinsertion, rebuild) that end in the same triangulation as a fresh build
- * and mark every ring they change, and stay regular through moves of a few ulps. */
+ * and mark every ring they change, and stay regular through moves of a few ulps; a raised
+ * cancel flag stops a build, an update, a rebuild and the walk of all the rings. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,7 +27,7 @@ static void test_hexagonal_patch_rings_are_six_touching_neighbours_ccw(void)
     size_t n = hex_patch(d, 7, 7, 0.0, 0.0);
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(d, n, &rt, &err) == 0);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     CHECK(gp_rt_count(rt) == n && gp_rt_dimension(rt) == 2);
     size_t interior = 0;
     for (size_t i = 0; i < n; i++) {
@@ -106,7 +107,7 @@ static void test_triangles_have_empty_power_circles_by_brute_force(void)
         size_t n = random_disks(d, WANT, 30.0, seed);
         gp_rt *rt;
         gp_error err;
-        CHECK(gp_rt_build(d, n, &rt, &err) == 0);
+        CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
         CHECK(gp_rt_is_regular(rt));
         size_t triangles = 0, hull = 0;
         for (size_t i = 0; i < n; i++) {
@@ -144,12 +145,12 @@ static void test_hidden_and_duplicate_disks_are_geometry_errors(void)
     gp_disk nested[4] = {{0, 0, 1, 1}, {5, 0, 1, 1}, {0, 5, 1, 1}, {0.05, 0, 0.05, 0.1}};
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(nested, 4, &rt, &err) == GP_EGEOM);
+    CHECK(gp_rt_build(nested, 4, NULL, &rt, &err) == GP_EGEOM);
     CHECK(rt == NULL);
     CHECK_MSG(strstr(err.message, "disk 3") && strstr(err.message, "hidden"), "%s", err.message);
 
     gp_disk twins[4] = {{0, 0, 1, 1}, {5, 0, 1, 1}, {0, 5, 1, 1}, {5, 0, 1, 1}};
-    CHECK(gp_rt_build(twins, 4, &rt, &err) == GP_EGEOM);
+    CHECK(gp_rt_build(twins, 4, NULL, &rt, &err) == GP_EGEOM);
     CHECK(strstr(err.message, "hidden") != NULL);
 }
 
@@ -159,12 +160,12 @@ static void test_degenerate_inputs_have_rings_too(void)
     gp_error err;
     int32_t nb[64];
     int hull;
-    CHECK(gp_rt_build(NULL, 0, &rt, &err) == 0);
+    CHECK(gp_rt_build(NULL, 0, NULL, &rt, &err) == 0);
     CHECK(gp_rt_count(rt) == 0 && gp_rt_dimension(rt) == -1);
     gp_rt_free(rt);
 
     gp_disk one = {1, 1, 0.5, 1};
-    CHECK(gp_rt_build(&one, 1, &rt, &err) == 0);
+    CHECK(gp_rt_build(&one, 1, NULL, &rt, &err) == 0);
     CHECK(gp_rt_dimension(rt) == 0 && ring(rt, 0, nb, &hull) == 0 && hull == 1);
     gp_rt_free(rt);
 
@@ -172,7 +173,7 @@ static void test_degenerate_inputs_have_rings_too(void)
     gp_disk row[5];
     for (int i = 0; i < 5; i++)
         row[i] = (gp_disk){1.0 + 2.0 * ((i * 3) % 5), 1.0, 0.9, 1.0};
-    CHECK(gp_rt_build(row, 5, &rt, &err) == 0);
+    CHECK(gp_rt_build(row, 5, NULL, &rt, &err) == 0);
     CHECK(gp_rt_dimension(rt) == 1);
     for (int i = 0; i < 5; i++) {
         size_t deg = ring(rt, i, nb, &hull);
@@ -211,7 +212,7 @@ static void check_all_rings(const gp_rt *rt, size_t n)
     size_t *start = malloc((n + 1) * sizeof *start);
     uint8_t *hull = malloc(n ? n : 1);
     int32_t *ids;
-    CHECK(gp_rt_rings(rt, start, hull, &ids) == 0);
+    CHECK(gp_rt_rings(rt, start, hull, &ids, NULL) == 0);
     size_t wrong = 0;
     for (size_t i = 0; i < n; i++) {
         int32_t nb[64];
@@ -273,14 +274,14 @@ static void test_all_rings_at_once_are_the_rings_one_by_one(void)
     gp_error err;
     pack_seed(&spec, 2, &pk);
     gp_rt *rt;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     check_all_rings(rt, pk.count);
     gp_rt_free(rt);
     /* a patch with its hull, a row (dimension 1), one disk, none */
     gp_disk d[49];
     size_t n = hex_patch(d, 7, 7, 0.0, 0.0);
     for (size_t m = 0; m <= n; m = m < 8 ? m + 1 : n) {
-        CHECK(gp_rt_build(d, m, &rt, &err) == 0);
+        CHECK(gp_rt_build(d, m, NULL, &rt, &err) == 0);
         check_all_rings(rt, m);
         gp_rt_free(rt);
         if (m == n)
@@ -303,7 +304,7 @@ static void test_updates_after_moves_match_a_fresh_build(void)
     for (size_t i = 0; i < pk.count; i++)
         pk.disks[i].R *= 1.0 / 3.0;
     gp_rt *rt, *fresh;
-    CHECK(gp_rt_build(pk.disks, pk.count, &rt, &err) == 0);
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
     gp_rng rng;
     gp_rng_seed(&rng, 7);
     int32_t *ids = malloc(pk.count * sizeof *ids);
@@ -319,7 +320,7 @@ static void test_updates_after_moves_match_a_fresh_build(void)
             pk.disks[i].y += step * (2.0 * gp_rng_uniform(&rng) - 1.0);
             ids[moved++] = (int32_t)i;
         }
-        CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, moved, GP_RT_UPDATE_FLIPS, &st, &err) == 0);
+        CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, moved, GP_RT_UPDATE_FLIPS, &st, NULL, &err) == 0);
         CHECK(gp_rt_is_regular(rt));
         check_all_rings(rt, pk.count);
         /* every ring the update changed is marked, and not every ring is: a disk far
@@ -333,7 +334,7 @@ static void test_updates_after_moves_match_a_fresh_build(void)
         memset(marks, 0, pk.count);
         free_rings(&before);
         free_rings(&after);
-        CHECK(gp_rt_build(pk.disks, pk.count, &fresh, &err) == 0);
+        CHECK(gp_rt_build(pk.disks, pk.count, NULL, &fresh, &err) == 0);
         CHECK_MSG(count_ring_differences(rt, fresh, pk.count) == 0, "round %d", round);
         gp_rt_free(fresh);
     }
@@ -342,7 +343,7 @@ static void test_updates_after_moves_match_a_fresh_build(void)
               (unsigned long long)st.flips, (unsigned long long)st.reinserted, (unsigned long long)st.rebuilds);
     /* the rebuild mode gives the same triangulation */
     gp_rt_update_stats rb = {0, 0, 0, 0};
-    CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, 1, GP_RT_UPDATE_REBUILD, &rb, &err) == 0);
+    CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, 1, GP_RT_UPDATE_REBUILD, &rb, NULL, &err) == 0);
     CHECK(rb.rebuilds == 1 && gp_rt_is_regular(rt));
     /* a rebuild marks every vertex */
     size_t marked = 0;
@@ -372,7 +373,7 @@ static void test_updates_stay_regular_on_near_ties(void)
         d[i] = (gp_disk){x0 + pitch * (i % SIDE), y0 + pitch * (i / SIDE), 0.13, 0.13};
     gp_rt *rt;
     gp_error err;
-    CHECK(gp_rt_build(d, SIDE * SIDE, &rt, &err) == 0);
+    CHECK(gp_rt_build(d, SIDE * SIDE, NULL, &rt, &err) == 0);
     gp_rng rng;
     gp_rng_seed(&rng, 11);
     int32_t ids[SIDE * SIDE];
@@ -388,10 +389,79 @@ static void test_updates_stay_regular_on_near_ties(void)
             d[i].y = y0 + pitch * (i / SIDE) + ky * ulp;
             ids[moved++] = i;
         }
-        CHECK(gp_rt_update_moved(rt, d, SIDE * SIDE, ids, moved, GP_RT_UPDATE_FLIPS, NULL, &err) == 0);
+        CHECK(gp_rt_update_moved(rt, d, SIDE * SIDE, ids, moved, GP_RT_UPDATE_FLIPS, NULL, NULL, &err) == 0);
         CHECK_MSG(gp_rt_is_regular(rt), "round %d", round);
     }
     gp_rt_free(rt);
+}
+
+/* A progress callback that counts its calls, checks the fractions rise, and raises the
+ * flag at the call `raise_at` (0: never). */
+typedef struct build_watch {
+    gp_cancel_flag flag;
+    int calls, raise_at;
+    double last;
+} build_watch;
+
+static void watch_build(void *ctx, const char *stage, double fraction)
+{
+    build_watch *w = ctx;
+    CHECK_STR(stage, "triangulation");
+    CHECK(fraction > w->last && fraction < 1.0);
+    w->last = fraction;
+    if (++w->calls == w->raise_at)
+        atomic_store(&w->flag, 1);
+}
+
+static void test_a_raised_flag_stops_builds_updates_and_measures(void)
+{
+    enum { ROWS = 100, COLS = 100, N = ROWS * COLS };
+    gp_disk *d = malloc(N * sizeof *d);
+    size_t n = hex_patch(d, ROWS, COLS, 0.0, 0.0);
+    gp_error err;
+    gp_rt *rt = NULL;
+    /* untouched, the build reports between its batches and ends */
+    build_watch w = {0, 0, 0, 0.0};
+    gp_progress progress = {watch_build, &w, &w.flag};
+    CHECK(gp_rt_build(d, n, &progress, &rt, &err) == 0 && rt);
+    CHECK_MSG(w.calls == (int)((n - 1) / GP_RT_INSERT_BATCH), "%d reports", w.calls);
+    gp_rt_free(rt);
+    /* raised at the first report, it stops at the next batch: no triangulation, no second
+     * report */
+    build_watch stop = {0, 0, 1, 0.0};
+    gp_progress stopping = {watch_build, &stop, &stop.flag};
+    rt = (gp_rt *)&stop; /* must come back NULL */
+    CHECK(gp_rt_build(d, n, &stopping, &rt, &err) == GP_ECANCELED && rt == NULL);
+    CHECK(stop.calls == 1 && strstr(err.message, "canceled after 8192 of 10000") != NULL);
+    /* raised before, the build stops in its spatial sort (10^4 disks: over 10^5
+     * comparisons, a check every 2^16); an update of more than a batch of moves stops,
+     * and so does a rebuild */
+    gp_cancel_flag raised;
+    atomic_init(&raised, 1);
+    gp_progress canceled = {NULL, NULL, &raised};
+    CHECK(gp_rt_build(d, n, &canceled, &rt, &err) == GP_ECANCELED && rt == NULL);
+    CHECK(strstr(err.message, "while sorting") != NULL);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    int32_t *ids = malloc(N * sizeof *ids);
+    for (size_t i = 0; i < n; i++)
+        ids[i] = (int32_t)i;
+    CHECK(gp_rt_update_moved(rt, d, n, ids, n, GP_RT_UPDATE_FLIPS, NULL, &canceled, &err) == GP_ECANCELED);
+    gp_rt_free(rt);
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    CHECK(gp_rt_update_moved(rt, d, n, ids, 1, GP_RT_UPDATE_REBUILD, NULL, &canceled, &err) == GP_ECANCELED);
+    gp_rt_free(rt);
+    /* the walk of all the rings (10^4 vertices: a check every GP_RT_RINGS_PER_CHECK of
+     * its 2 * 10^4 steps) stops too, and hands back no array */
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    size_t *start = malloc((n + 1) * sizeof *start);
+    int32_t *rings = (int32_t *)&raised; /* must come back NULL */
+    CHECK(gp_rt_rings(rt, start, NULL, &rings, &canceled) == GP_ECANCELED && rings == NULL);
+    CHECK(gp_rt_rings(rt, start, NULL, &rings, NULL) == 0 && rings != NULL);
+    free(rings);
+    free(start);
+    gp_rt_free(rt);
+    free(ids);
+    free(d);
 }
 
 int main(void)
@@ -403,5 +473,6 @@ int main(void)
     RUN(test_all_rings_at_once_are_the_rings_one_by_one);
     RUN(test_updates_after_moves_match_a_fresh_build);
     RUN(test_updates_stay_regular_on_near_ties);
+    RUN(test_a_raised_flag_stops_builds_updates_and_measures);
     return check_status();
 }

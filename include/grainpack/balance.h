@@ -95,9 +95,14 @@ typedef struct gp_quality_stats {
  * triangulation has long thin triangles across the empty outside, and a centre touching
  * one has "neighbours" far along the wall whose gaps say nothing of the free space around
  * it. These centres (the layer along the walls) are also the ones balancing leaves in
- * place. F may be NULL when only the statistics are wanted. Returns 0 or GP_ENOMEM. */
+ * place. F may be NULL when only the statistics are wanted. Returns 0, GP_ENOMEM or
+ * GP_ECANCELED (*cancel, which may be NULL, is read every GP_QUALITY_CENTRES_PER_CHECK
+ * centres). */
 int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, gp_error *err);
+               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err);
+
+/* Centres measured between two reads of the cancel flag: a few milliseconds of work. */
+#define GP_QUALITY_CENTRES_PER_CHECK 16384
 
 typedef struct gp_balance_params {
     gp_balance_method method;

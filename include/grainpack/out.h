@@ -1,5 +1,5 @@
 /* out.h - a buffered byte sink, and the number formats every writer uses: the shortest
- * decimal that reads back to the same double (double-conversion, from Debian), fixed
+ * decimal that reads back to the same double (Dragonbox, from Debian), fixed
  * decimals for picture coordinates, integers. Writers emit into a gp_out; where the bytes
  * go (a FILE, a growing buffer a server drains piece by piece) is the sink's business. */
 #ifndef GRAINPACK_OUT_H
@@ -45,6 +45,9 @@ int gp_out_init_file(gp_out *o, FILE *file);
 
 void gp_out_write(gp_out *o, const void *data, size_t len);
 void gp_out_puts(gp_out *o, const char *text);
+/* gp_out_puts of a string literal, its length known when compiled (no strlen on the hot
+ * paths). */
+#define GP_OUT_LITERAL(o, literal) gp_out_write((o), "" literal, sizeof(literal) - 1)
 void gp_out_char(gp_out *o, char c);
 /* The shortest decimal that reads back (strtod) to exactly x: 0.06, 1e-7, 123456, 1.5e+300;
  * "NaN", "Infinity" and "-Infinity" for the non-finite (writers that cannot show them
@@ -55,6 +58,10 @@ void gp_out_double(gp_out *o, double x);
 void gp_out_fixed(gp_out *o, double x, int decimals);
 void gp_out_int(gp_out *o, int64_t v);
 void gp_out_uint(gp_out *o, uint64_t v);
+/* printf into the buffer: for captions and other text off the hot paths (at most
+ * GP_OUT_PRINTF_MAX bytes; longer text is cut). */
+#define GP_OUT_PRINTF_MAX 1024
+void gp_out_printf(gp_out *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
 
 /* Hands what is buffered to the sink (no-op in memory mode). Returns o->err. */
 int gp_out_flush(gp_out *o);

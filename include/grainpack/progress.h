@@ -23,6 +23,23 @@ typedef struct gp_progress {
     const gp_cancel_flag *cancel;
 } gp_progress;
 
+/* Whether the flag (NULL: none) is raised. A relaxed load: a stage only needs to see the
+ * flag soon, not in any order with other memory. */
+static inline int gp_canceled(const gp_cancel_flag *cancel)
+{
+#ifdef __cplusplus
+    return cancel && cancel->load(std::memory_order_relaxed) != 0;
+#else
+    return cancel && atomic_load_explicit(cancel, memory_order_relaxed) != 0;
+#endif
+}
+
+/* The flag of a progress (NULL for none). */
+static inline const gp_cancel_flag *gp_progress_cancel(const gp_progress *progress)
+{
+    return progress ? progress->cancel : NULL;
+}
+
 #ifdef __cplusplus
 }
 #endif

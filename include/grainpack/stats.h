@@ -30,6 +30,7 @@ typedef struct gp_pack_stats {
     double packing_density;  /* sum pi R^2 / area */
     double grain_fraction;   /* sum pi r^2 / area */
     double r_min, r_max, r_mean; /* achieved grain radii (0 without disks) */
+    double joint_min, joint_max; /* of the joint thickness R - r (0 without disks) */
     size_t nbins;
     gp_bin_stat *bins;       /* owned */
     double chi2;             /* Pearson's statistic over bins with target > 0 */
@@ -52,6 +53,8 @@ void gp_pack_stats_free(gp_pack_stats *stats);
  * grain-boundary band, and how the cells' equivalent radii compare with the target law. */
 typedef struct gp_cell_stats {
     size_t count;
+    size_t vertices;         /* over all cells */
+    size_t neighbour_links;  /* entries of all neighbour lists (twice the pairs) */
     double area_min, area_max, area_mean;  /* of the (shrunk) cells */
     size_t area_histogram[GP_CELL_AREA_BINS];
     double neighbours_mean;

@@ -10,6 +10,7 @@
 
 #include "grainpack/disk.h"
 #include "grainpack/error.h"
+#include "grainpack/progress.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -30,9 +31,18 @@ typedef struct gp_rt gp_rt;
  * and *out owns the triangulation (free with gp_rt_free). Fails with GP_ENOMEM,
  * GP_ETOOBIG (n does not fit an int32_t id), GP_EGEOM when some disk has no vertex (a
  * hidden vertex: its disk lies inside the power cells of others, which non-overlapping
- * packing disks never do; also two disks with the same centre), or GP_EINTERNAL when CGAL
- * reports a failure; err says which disk or what CGAL said, and *out is NULL. */
-int gp_rt_build(const gp_disk *disks, size_t n, gp_rt **out, gp_error *err);
+ * packing disks never do; also two disks with the same centre), GP_ECANCELED when
+ * progress->cancel was raised, or GP_EINTERNAL when CGAL reports a failure; err says
+ * which disk or what CGAL said, and *out is NULL. The points are spatially sorted (one
+ * pass CGAL cannot interrupt: 0.1 s a million points) and inserted in batches of
+ * GP_RT_INSERT_BATCH; between two batches the cancel flag is read and progress reported
+ * as stage "triangulation". `progress` may be NULL.
+ * (A gp_progress rather than its flag: C and C++ see the flag as two different types.) */
+int gp_rt_build(const gp_disk *disks, size_t n, const gp_progress *progress, gp_rt **out,
+                gp_error *err);
+
+/* Points inserted between two reads of the cancel flag: a few milliseconds of work. */
+#define GP_RT_INSERT_BATCH 4096
 
 /* Frees the triangulation (no-op on NULL). */
 void gp_rt_free(gp_rt *rt) GP_RT_NOEXCEPT;
@@ -67,8 +77,15 @@ size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
  * together; asking gp_rt_ring for each id in turn jumps across the whole structure for
  * every ring (at 10^6 grains that walk was half of the Laguerre cells' time). `start`
  * (gp_rt_count + 1 entries) and `hull` (gp_rt_count, or NULL when not wanted) are the
- * caller's; *ids is allocated here and the caller frees it. Returns 0 or GP_ENOMEM (*ids is then NULL). */
-int gp_rt_rings(const gp_rt *rt, size_t *start, uint8_t *hull, int32_t **ids) GP_RT_NOEXCEPT;
+ * caller's; *ids is allocated here and the caller frees it. Returns 0, GP_ENOMEM or
+ * GP_ECANCELED (progress->cancel is read every GP_RT_RINGS_PER_CHECK vertices of each of
+ * the two walks; no progress is reported; `progress` may be NULL); *ids is then NULL. */
+int gp_rt_rings(const gp_rt *rt, size_t *start, uint8_t *hull, int32_t **ids,
+                const gp_progress *progress) GP_RT_NOEXCEPT;
+
+/* Rings walked between two reads of the cancel flag: as many as the centres gp_quality
+ * measures between two (a ring costs less than a centre's F): well under a millisecond. */
+#define GP_RT_RINGS_PER_CHECK 16384
 
 /* How to bring the triangulation up to date after centres moved. */
 typedef enum gp_rt_update {
@@ -92,10 +109,13 @@ typedef struct gp_rt_update_stats {
 
 /* Brings the triangulation up to date after the centres of disks[ids[k]] (k < nids)
  * moved; `disks` is the array it was built from, with the new positions (the radii must
- * not have changed). Returns 0 or, as gp_rt_build, GP_ENOMEM, GP_EGEOM or GP_EINTERNAL;
- * on failure the triangulation must only be freed. `stats` may be NULL. */
+ * not have changed). Returns 0 or, as gp_rt_build, GP_ENOMEM, GP_EGEOM, GP_ECANCELED
+ * (progress->cancel is read every GP_RT_INSERT_BATCH moves, and as gp_rt_build reads it;
+ * no progress is reported) or GP_EINTERNAL; on failure the triangulation must only be
+ * freed. `stats` and `progress` may be NULL. */
 int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks, const int32_t *ids,
-                       size_t nids, gp_rt_update mode, gp_rt_update_stats *stats, gp_error *err);
+                       size_t nids, gp_rt_update mode, gp_rt_update_stats *stats,
+                       const gp_progress *progress, gp_error *err);
 
 /* Has every later update of rt set marks[id] = 1 for each vertex whose ring (its
  * neighbours, their order, whether it is on the hull) it may have changed: the four

@@ -180,9 +180,9 @@ static void setup(void)
     atomic_init(&svc.queued, 0);
     atomic_init(&svc.accepting, 1);
     char why[256];
-    if (gp_store_open(cfg.db_path, &svc.store, NULL, why, sizeof why) ||
+    if (gp_store_open(cfg.db_path, &svc.store, why, sizeof why) ||
         gp_keyring_load(cfg.key_file, &svc.keys, why, sizeof why) ||
-        !(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new()) ||
+        !(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new(&svc.http)) ||
         gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_http_start_embedded(&svc, &daemon_)) {
         fprintf(stderr, "fuzz_http: cannot set up the service: %s\n", why);
         abort();

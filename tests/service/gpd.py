@@ -4,6 +4,7 @@ that a response matches its schema in openapi.yaml, and a few assertions.
 
 Only Debian's python3 with python3-yaml and python3-jsonschema (see .ci/setup)."""
 
+import gzip
 import hashlib
 import http.client
 import json
@@ -248,23 +249,29 @@ class Daemon:
 
 def check_store(checks, daemon, what):
     """The database file is sound and holds no half-written result: integrity_check is
-    ok; every successful job has its disks (32 bytes each, as many as its count), its
-    per-bin statistics and its stage timings; no other job has a result. Returns the
+    ok; every successful job has its summary and its disks (32 bytes each, as many as its
+    count, in chunks adding up to the section), its per-bin statistics and its stage
+    timings; no other job has a result, and no chunk is left of a deleted one. Returns the
     {id: status} of every job."""
     db = daemon.db()
     try:
         checks.check(db.execute("PRAGMA integrity_check").fetchone()[0] == "ok", f"{what}: integrity_check")
         bad = db.execute(
-            "SELECT j.id, j.status, j.count, r.count, length(r.disks),"
-            " (SELECT count(*) FROM bin_stats b WHERE b.job_id = j.id),"
-            " (SELECT count(*) FROM stage_timings t WHERE t.job_id = j.id)"
-            " FROM jobs j LEFT JOIN results r ON r.job_id = j.id"
-            " WHERE (j.status = 'successful' AND (r.count IS NULL OR r.count != j.count"
-            "   OR length(r.disks) != 32 * j.count"
+            "SELECT j.id, j.status, j.count, d.bytes,"
+            " (SELECT sum(length(c.data)) FROM result_chunks c WHERE c.section = d.id)"
+            " FROM jobs j LEFT JOIN result_sections d ON d.job_id = j.id AND d.tag = 'disks'"
+            " WHERE (j.status = 'successful' AND (d.bytes IS NULL OR d.bytes != 32 * j.count"
+            "   OR (j.count > 0 AND (SELECT sum(length(c.data)) FROM result_chunks c"
+            "                        WHERE c.section = d.id) != d.bytes)"
+            "   OR NOT EXISTS (SELECT 1 FROM result_sections p WHERE p.job_id = j.id AND p.tag = 'pack')"
             "   OR NOT EXISTS (SELECT 1 FROM bin_stats b WHERE b.job_id = j.id)"
             "   OR NOT EXISTS (SELECT 1 FROM stage_timings t WHERE t.job_id = j.id)))"
-            " OR (j.status != 'successful' AND r.job_id IS NOT NULL)").fetchall()
+            " OR (j.status != 'successful' AND EXISTS"
+            "   (SELECT 1 FROM result_sections s WHERE s.job_id = j.id))").fetchall()
         checks.check(not bad, f"{what}: jobs with a half-written or stray result: {bad[:5]}")
+        orphans = db.execute("SELECT count(*) FROM result_chunks WHERE section NOT IN"
+                             " (SELECT id FROM result_sections)").fetchone()[0]
+        checks.check(orphans == 0, f"{what}: {orphans} result chunks belong to no result")
         return dict(db.execute("SELECT id, status FROM jobs").fetchall())
     finally:
         db.close()  # (a `with` block would leave it open)
@@ -293,9 +300,10 @@ class OpenAPI:
     def schema(self, name):
         return self.doc["components"]["schemas"][name]
 
-    def check(self, checks, method, template, resp):
-        """Checks that resp is documented for (method, template) and its body matches the
-        documented schema; returns whether it did."""
+    def check(self, checks, method, template, resp, body_schema=True):
+        """Checks that resp is documented for (method, template), with its required
+        headers, and that its body matches the documented schema (unless body_schema is
+        false: a large body another test checks); returns whether it did."""
         what = f"{method} {template} -> {resp.status}"
         op = self.doc["paths"].get(template, {}).get(method.lower())
         if not checks.check(op is not None, f"{what}: not in openapi.yaml"):
@@ -305,23 +313,38 @@ class OpenAPI:
             return False
         documented = self._deref(documented)
         ok = True
-        for header in documented.get("headers", {}):
-            ok &= checks.check(header.lower() in resp.headers, f"{what}: no {header} header")
-        content = documented.get("content", {})
-        if not content:  # documented without a body (304): there must be none
-            return checks.check(not resp.body, f"{what}: a body where none is documented") and ok
+        for header, spec in documented.get("headers", {}).items():
+            spec = self._deref(spec)
+            present = header.lower() in resp.headers
+            if spec.get("required"):
+                ok &= checks.check(present, f"{what}: no {header} header")
+            if present:
+                value = resp.headers[header.lower()]
+                schema = self._deref(spec.get("schema", {}))
+                if schema.get("type") == "integer" and value.isdigit():
+                    value = int(value)
+                errors = self.validate(schema, value)
+                ok &= checks.check(not errors, f"{what}: header {header}: {errors[:2]}")
+        content = documented.get("content")
+        if not content:  # 304: no body
+            return checks.check(resp.body == b"", f"{what}: a body where none is documented") and ok
+        body = resp.body
+        if resp.headers.get("content-encoding") == "gzip":
+            body = gzip.decompress(body)
         media = content.get(resp.content_type)
         if not checks.check(media is not None,
                             f"{what}: content type {resp.content_type!r} not documented"):
             return False
         schema = media.get("schema", {})
+        if not body_schema:
+            return ok
         if resp.content_type.endswith("json"):
             try:
-                body = resp.json()
+                body = json.loads(body)
             except ValueError as e:
                 return checks.check(False, f"{what}: body is not JSON: {e}")
         else:
-            body = resp.body.decode("utf-8", "replace")
+            body = body.decode("utf-8", "replace")
         errors = self.validate(schema, body)
         return checks.check(not errors, f"{what}: body does not match its schema: {errors[:3]}") and ok
 

@@ -5,7 +5,8 @@ WWW-Authenticate) while what the service is stays public; a job is seen only by 
 that submitted it (others get 404, and do not see it in /jobs) and by admins, who also
 dismiss it; /metrics is admin-only (403); the per-key limit answers 429; SIGHUP reads
 the key file again (a rotated key keeps its jobs, a revoked one is refused, a broken file
-keeps the old keys); a daemon without keys refuses a non-loopback address unless told.
+keeps the old keys); /jobs page cursors are opaque tokens of one viewer; a daemon
+without keys refuses a non-loopback address unless told.
 Usage: test_service_access.py GRAINPACKD"""
 
 import os
@@ -163,6 +164,72 @@ def test_keys(c, api, binary):
         gpd.remove_tree(directory)
 
 
+def page_through(client, path):
+    """Follows the next links from path; returns (job ids in order, the cursors seen)."""
+    ids, cursors = [], []
+    while path:
+        r = client.get(path)
+        assert r.status == 200, f"GET {path}: {r}"
+        ids += [j["jobID"] for j in r.json()["jobs"]]
+        nxt = [link["href"] for link in r.json()["links"] if link["rel"] == "next"]
+        path = nxt[0] if nxt else None
+        if path:
+            cursors.append(re.search(r"[?&]cursor=([^&]*)", path).group(1))
+    return ids, cursors
+
+
+def test_cursors(c, api, binary):
+    """/jobs cursors are opaque and per viewer: alice's pages hold her jobs only, in order;
+    her cursor is a token that shows no sequence number, is refused to bob and to an admin,
+    refused when altered, and refused after a restart (it is valid until the daemon stops)."""
+    directory = tempfile.mkdtemp(prefix="grainpackd-cursors-")
+    key_file = os.path.join(directory, "keys")
+    keys = gpd.write_keys(key_file, {"alice": "user", "bob": "user", "root": "admin"})
+    daemon = gpd.Daemon(binary, "--workers", "1", "--key-file", key_file, data_dir=directory)
+    try:
+        daemon.start()
+        alice, bob, root = (daemon.client(keys[u]) for u in ("alice", "bob", "root"))
+        mine = []
+        for i in range(4):  # bob submits between alice's jobs
+            mine.append(alice.submit(gpd.small_spec(seed=i)).json()["jobID"])
+            for k in range(2):
+                bob.submit(gpd.small_spec(seed=10 + 2 * i + k))
+        ids, cursors = page_through(alice, "/jobs?limit=1")
+        c.check(ids == mine[::-1], f"alice's pages: {ids}")
+        c.check(len(cursors) == 3 and all(re.fullmatch(r"[0-9a-f]{32}", t) for t in cursors),
+                f"alice's cursors are not 32-hex tokens: {cursors}")
+        with daemon.db() as db:
+            seqs = [str(s) for (s,) in db.execute("SELECT seq FROM jobs WHERE owner = 'alice'")]
+        c.check(not any(t in seqs for t in cursors), "a cursor is a sequence number")
+        r = alice.get(f"/jobs?limit=1&cursor={cursors[0]}")
+        c.check(r.status == 200 and [j["jobID"] for j in r.json()["jobs"]] == [mine[2]], f"alice reuses her cursor: {r}")
+        altered = cursors[0][:-1] + ("0" if cursors[0][-1] != "0" else "1")
+        for who, client, token in (("bob", bob, cursors[0]), ("root", root, cursors[0]),
+                                   ("alice, altered", alice, altered), ("alice, a number", alice, "7")):
+            r = client.get(f"/jobs?limit=1&cursor={token}")
+            c.check(r.status == 400 and r.json()["type"] == "urn:grainpack:problem:bad-parameter"
+                    and "next link" in r.json()["detail"], f"{who} with alice's cursor: {r}")
+            api.check(c, "GET", "/jobs", r)
+        # root sees every job, a page at a time, with cursors of its own
+        ids, root_cursors = page_through(root, "/jobs?limit=5")
+        c.check(len(ids) == 12 and len(set(ids)) == 12 and set(mine) <= set(ids), f"root's pages: {ids}")
+        c.check(not set(root_cursors) & set(cursors), "root and alice share cursors")
+        for client in (alice, bob, root):
+            client.close()
+        c.check(daemon.stop() == 0, "stop")
+        daemon.start()
+        alice = daemon.client(keys["alice"])
+        r = alice.get(f"/jobs?limit=1&cursor={cursors[0]}")
+        c.check(r.status == 400 and "restarts" in r.json()["detail"], f"a cursor after a restart: {r}")
+        ids, again = page_through(alice, "/jobs?limit=1")
+        c.check(ids == mine[::-1] and not set(again) & set(cursors), "new cursors after a restart")
+        alice.close()
+        c.check(daemon.stop() == 0, "second stop")
+    finally:
+        daemon.cleanup()
+        gpd.remove_tree(directory)
+
+
 def test_open_mode(c, binary):
     # without keys: loopback only, unless --insecure-open
     r = subprocess.run([binary, "--host", "0.0.0.0", "--port", "0"], capture_output=True, text=True, timeout=60)
@@ -181,6 +248,7 @@ def test_open_mode(c, binary):
 def test(c, binary):
     api = gpd.OpenAPI()
     test_keys(c, api, binary)
+    test_cursors(c, api, binary)
     test_open_mode(c, binary)
 
 

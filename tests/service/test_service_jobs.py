@@ -71,7 +71,7 @@ def test_dismissal(c, api, daemon, client):
         c.check(row == ("dismissed", None, 0), f"the dismissed queued job ran: {row}")
         row = db.execute("SELECT status, count, claims FROM jobs WHERE id = ?", (big_id,)).fetchone()
         c.check(row == ("dismissed", None, 1), f"the dismissed running job: {row}")
-        c.check(db.execute("SELECT count(*) FROM results WHERE job_id = ?", (big_id,)).fetchone()[0] == 0,
+        c.check(db.execute("SELECT count(*) FROM result_sections WHERE job_id = ?", (big_id,)).fetchone()[0] == 0,
                 "a dismissed job has a result")
 
     # deleting finished jobs: gone with their rows
@@ -81,10 +81,13 @@ def test_dismissal(c, api, daemon, client):
         r = client.get(f"/jobs/{job}")
         c.check(r.status == 404, f"GET a deleted job: {r}")
         with daemon.db() as db:
-            for table, key in (("jobs", "id"), ("results", "job_id"), ("bin_stats", "job_id"),
+            for table, key in (("jobs", "id"), ("result_sections", "job_id"), ("bin_stats", "job_id"),
                                ("stage_timings", "job_id")):
                 n = db.execute(f"SELECT count(*) FROM {table} WHERE {key} = ?", (job,)).fetchone()[0]
                 c.check(n == 0, f"{table} keeps {n} rows of deleted job {job}")
+            n = db.execute("SELECT count(*) FROM result_chunks WHERE section NOT IN"
+                           " (SELECT id FROM result_sections)").fetchone()[0]
+            c.check(n == 0, f"{n} chunks of deleted results are left")
     return queued_id
 
 

@@ -36,9 +36,12 @@ def test(c, binary):
             c.check(run.returncode == 0, f"walk-through exited {run.returncode}: {run.stderr[-500:]}")
             svg = open(os.path.join(work, "bagi.svg")).read() if os.path.exists(os.path.join(work, "bagi.svg")) else ""
             c.check(svg.rstrip().endswith("</svg>"), "bagi.svg is not a whole SVG")
+            saved = [f for f in os.listdir(work) if re.fullmatch(r"job-[0-9a-f-]{36}\.csv", f)]
+            c.check(len(saved) == 1 and open(os.path.join(work, saved[0])).read().startswith("x,y,r,R\n"),
+                    f"the download was not saved as job-<id>.csv (decompressed): {os.listdir(work)}")
         for expected in ['"conformsTo"', '"id":"pack2d"', "job at http://", '"status":"successful"',
                          "<!doctype html>", '"valid":true,"expected_disks":',
-                         "x,y,r,R", '"packing_density"', '"timings"', '"status":"dismissed"', "\n404\n",
+                         "x,y,r,R", '"packing_density"', '"timings"', "\n304\n", '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
                          'grainpack_jobs{status="successful"}', "openapi: 3.1.0"]:
             c.check(expected in out, f"walk-through output lacks {expected!r}")

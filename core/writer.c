@@ -1,0 +1,140 @@
+/* writer.c - running a writer's steps (writer.h) window by window, resumable between two
+ * grains; the source of a result held in memory; format dispatch. */
+#include "writer.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void gp_writer_text(gp_writer *w, gp_text_fn fn, int param)
+{
+    if (w->nsteps == GP_WRITER_MAX_STEPS) {
+        w->overflow = 1;
+        return;
+    }
+    w->steps[w->nsteps++] = (gp_writer_step){fn, NULL, 0, param};
+}
+
+void gp_writer_grains(gp_writer *w, gp_grain_fn fn, unsigned needs, int param)
+{
+    if (w->nsteps == GP_WRITER_MAX_STEPS) {
+        w->overflow = 1;
+        return;
+    }
+    w->steps[w->nsteps++] = (gp_writer_step){NULL, fn, needs, param};
+}
+
+static int load_memory(void *ctx, unsigned needs, size_t first, gp_grain_window *win)
+{
+    (void)needs;
+    (void)first;
+    const gp_result *r = ctx;
+    *win = (gp_grain_window){
+        .first = 0,
+        .count = r->packing.count,
+        .disks = r->packing.disks,
+        .F = r->has_balance ? r->balance.F : NULL,
+        .area = r->has_cells ? r->cells.area : NULL,
+        .start = r->has_cells ? r->cells.start : NULL,
+        .xy = r->has_cells ? r->cells.xy : NULL,
+        .nstart = r->has_cells ? r->cells.nstart : NULL,
+        .neighbours = r->has_cells ? r->cells.neighbours : NULL,
+    };
+    return 0;
+}
+
+gp_grain_source gp_grain_source_memory(const gp_result *result)
+{
+    gp_grain_source s = {load_memory, (void *)result, 0, 0};
+    if (result->has_cells && result->cells.start) {
+        s.vertex_count = result->cells.start[result->cells.count];
+        s.neighbour_count = result->cells.nstart[result->cells.count];
+    }
+    return s;
+}
+
+gp_writer *gp_writer_new(gp_format format, const gp_spec *spec, const gp_result *result,
+                         const gp_grain_source *source)
+{
+    gp_writer *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    w->format = format;
+    w->spec = spec;
+    w->result = result;
+    w->source = *source;
+    w->grains = result->packing.count;
+    int rc = GP_EINVAL;
+    switch (format) {
+    case GP_FORMAT_JSON: rc = gp_plan_json(w); break;
+    case GP_FORMAT_CSV: rc = gp_plan_csv(w); break;
+    case GP_FORMAT_SVG: rc = gp_plan_svg(w); break;
+    case GP_FORMAT_VTK: rc = gp_plan_vtk(w); break;
+    }
+    if (rc || w->overflow) {
+        gp_writer_free(w);
+        return NULL;
+    }
+    return w;
+}
+
+void gp_writer_free(gp_writer *w)
+{
+    if (!w)
+        return;
+    if (w->drop && w->state)
+        w->drop(w->state);
+    free(w->state);
+    free(w);
+}
+
+/* Runs the pass of step s from grain w->next until the grains end or out holds `want`
+ * bytes. Returns 0 or the source's error. */
+static int run_pass(gp_writer *w, const gp_writer_step *s, gp_out *out, size_t want)
+{
+    while (w->next < w->grains && out->len < want && !out->err) {
+        gp_grain_window win;
+        int rc = w->source.load(w->source.ctx, s->needs, w->next, &win);
+        if (rc)
+            return rc;
+        size_t j = w->next - win.first;
+        while (j < win.count && out->len < want) /* a file sink keeps len below its capacity */
+            s->grain(w, out, &win, j++, s->param);
+        w->next = win.first + j;
+    }
+    return 0;
+}
+
+int gp_writer_run(gp_writer *w, gp_out *out, size_t want)
+{
+    while (w->step < w->nsteps) {
+        if (out->err)
+            return out->err;
+        if (out->len >= want)
+            return 1;
+        const gp_writer_step *s = &w->steps[w->step];
+        if (s->text) {
+            s->text(w, out, s->param);
+        } else {
+            int rc = run_pass(w, s, out, want);
+            if (rc)
+                return rc;
+            if (w->next < w->grains)
+                continue; /* out is full (or failed): the next call goes on */
+        }
+        w->step++;
+        w->next = 0;
+    }
+    return out->err;
+}
+
+int gp_write_result(gp_out *out, gp_format format, const gp_spec *spec, const gp_result *result)
+{
+    gp_grain_source source = gp_grain_source_memory(result);
+    gp_writer *w = gp_writer_new(format, spec, result, &source);
+    if (!w)
+        return GP_ENOMEM;
+    int rc = gp_writer_run(w, out, SIZE_MAX);
+    gp_writer_free(w);
+    int flushed = gp_out_flush(out);
+    return rc ? rc : flushed;
+}

@@ -1,0 +1,98 @@
+/* sections.h - a result as tagged binary sections, the form a store keeps it in: what
+ * each stage produced, each section named by a tag, with the version of its layout, so
+ * that a reader skips tags it does not know and a later stage (a mesh) adds its own.
+ *
+ * Tags and layouts (version 1; little-endian; f64 = IEEE double, u32/u64/i32 integers):
+ *   "pack"            the packing's diagnostics and statistics (gp_pack_stats, with its bins)
+ *   "disks"           per grain: x, y, r, R (f64 each, 32 bytes)
+ *   "balance"         the balancing run: method, step, F before and after (gp_quality_stats),
+ *                     sweeps, stop, moves, how the triangulation followed
+ *   "F"               per grain: F after balancing (f64, NaN where undefined)
+ *   "cells"           the cells' summary (count, shrink, totals) and gp_cell_stats
+ *   "cell_sizes"      per grain: vertices, neighbours of its cell (u32 each)
+ *   "cell_xy"         per vertex: x, y (f64 each), cell after cell
+ *   "cell_area"       per grain: its cell's area (f64)
+ *   "cell_neighbours" per neighbour: its grain id (i32), cell after cell
+ * The small sections ("pack", "balance", "cells") make a result's summary: the statistics
+ * and everything a writer needs but the per-grain arrays, which a writer reads window by
+ * window through gp_sections_source (io.h) without holding the whole result. */
+#ifndef GRAINPACK_SECTIONS_H
+#define GRAINPACK_SECTIONS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grainpack/io.h"
+#include "grainpack/pipeline.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define GP_SECTION_PACK "pack"
+#define GP_SECTION_DISKS "disks"
+#define GP_SECTION_BALANCE "balance"
+#define GP_SECTION_F "F"
+#define GP_SECTION_CELLS "cells"
+#define GP_SECTION_CELL_SIZES "cell_sizes"
+#define GP_SECTION_CELL_XY "cell_xy"
+#define GP_SECTION_CELL_AREA "cell_area"
+#define GP_SECTION_CELL_NEIGHBOURS "cell_neighbours"
+
+/* The longest tag, with its NUL. */
+#define GP_SECTION_TAG_SIZE 24
+/* The most sections a result has today. */
+#define GP_SECTIONS_MAX 16
+
+typedef struct gp_section {
+    char tag[GP_SECTION_TAG_SIZE];
+    uint32_t version;   /* of the layout */
+    int summary;        /* one of the small sections a summary is decoded from */
+    const void *data;   /* the bytes: borrowed from the result, or `owned` */
+    size_t size;
+    void *owned;        /* malloc'd bytes to free with gp_sections_free, or NULL */
+} gp_section;
+
+/* Cuts `result` into sections (at most GP_SECTIONS_MAX, their number in *n). The large
+ * arrays are borrowed from the result where their layout is the stored one (the result
+ * must then outlive the sections); the rest is encoded into owned buffers. Returns 0 or
+ * GP_ENOMEM (then nothing is left to free), GP_ETOOBIG when a cell has more than 2^32
+ * vertices. Free with gp_sections_free. */
+int gp_sections_from_result(const gp_result *result, gp_section *sections, size_t *n);
+void gp_sections_free(gp_section *sections, size_t n);
+
+/* Decodes one summary section into `summary` (which starts zeroed, and takes the
+ * sections in any order): "pack" sets the packing's counts and statistics, "balance"
+ * has_balance and its figures, "cells" has_cells, the cells' counts and statistics. Other
+ * tags are ignored (returns 0). The per-grain arrays stay NULL. Returns 0, GP_ENOMEM, or
+ * GP_EPARSE when the bytes do not hold the layout of that version (GP_EINVAL for a
+ * version this build does not know). `summary` owns what is decoded: free it with
+ * gp_result_free. */
+int gp_section_decode_summary(const char *tag, uint32_t version, const void *data, size_t size,
+                              gp_result *summary);
+
+/* Reads `len` bytes of section `tag` from byte `offset` into dst: 0, or a negative code
+ * (GP_EPARSE when the section is shorter) that stops the writer. */
+typedef int (*gp_section_read_fn)(void *ctx, const char *tag, uint64_t offset, void *dst,
+                                  size_t len);
+
+/* Grains a window of a stored result holds: the buffers then take about 300 bytes a
+ * grain (disks, F, area, a cell's six or so vertices), some 300 KB. */
+#define GP_SECTIONS_WINDOW_GRAINS 1024
+
+typedef struct gp_sections_source gp_sections_source;
+
+/* The per-grain arrays of a stored result, read through `read` (ctx is its argument)
+ * window by window, `window` grains at a time (0: GP_SECTIONS_WINDOW_GRAINS). `summary`
+ * (decoded by gp_section_decode_summary) is borrowed and must outlive the source.
+ * Returns NULL when out of memory. Free with gp_sections_source_free. */
+gp_sections_source *gp_sections_source_new(const gp_result *summary, gp_section_read_fn read,
+                                           void *ctx, size_t window);
+/* The source for gp_writer_new; valid while `s` lives. */
+gp_grain_source gp_sections_source_grains(gp_sections_source *s);
+void gp_sections_source_free(gp_sections_source *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
