@@ -1,15 +1,19 @@
-/* balance.c - the quality criterion F and the two balancing methods of docs/method.md §4: sweeps
- * that move each interior centre a step toward a target (the barycentre of its neighbours,
- * or of the positions tangent to its ball's boundary edges), refused when the step would
- * overlap a disk or leave the domain. */
+/* balance.c - the two balancing methods of docs/method.md §4: sweeps that move each interior
+ * centre a step toward a target (the barycentre of its neighbours, or of the positions
+ * tangent to its ball's boundary edges), refused when the step would overlap a disk or
+ * leave the domain, until the structure stops improving (§4.5). Between sweeps only what
+ * the moves changed is redone: the rings the triangulation's update changed, F where a
+ * centre or a neighbour moved; the results are those of redoing everything, to the bit. */
+#include "grow.h"
 #include "grainpack/balance.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "grid.h"
-#include "grow.h"
+#include "nearby.h"
+#include "quality.h"
+#include "rings.h"
 
 /* Steps tried toward the target, as fractions w of the way: from the largest allowed
  * (gp_balance_params.max_step) down by 0.05 to 0.05, as report Algorithm 3 does from
@@ -18,6 +22,12 @@
 
 /* Centres between two progress reports and cancel checks: a few milliseconds of work. */
 #define CENTRES_PER_REPORT GP_QUALITY_CENTRES_PER_CHECK
+
+/* The box of the positions a centre tries is widened by this fraction of its radius, so
+ * that the positions on the way to its target, which rounding can put a few ulps outside
+ * the box of the tangent positions they are averaged from, still fall inside; a position
+ * outside is tested against the grid cells around it instead (the same answer, slower). */
+#define BOX_MARGIN_RTOL 1e-6
 
 const char *gp_balance_method_name(gp_balance_method method)
 {
@@ -29,133 +39,35 @@ const char *gp_balance_method_name(gp_balance_method method)
     return "?";
 }
 
-/* A growable buffer for rings. */
-typedef struct ring_buffer {
-    int32_t *ids;
-    size_t cap;
-} ring_buffer;
-
-/* The ring of `id` in buf; returns its degree, or (size_t)-1 when out of memory. */
-static size_t ring_of(const gp_rt *rt, int32_t id, ring_buffer *buf, int *on_hull)
-{
-    for (;;) {
-        size_t degree = gp_rt_ring(rt, id, buf->ids, buf->cap, on_hull);
-        if (degree <= buf->cap)
-            return degree;
-        int32_t *grown = grow(buf->ids, &buf->cap, degree, sizeof *grown);
-        if (!grown)
-            return (size_t)-1;
-        buf->ids = grown;
-    }
-}
-
-/* F(p) of docs/method.md §4.2 for the disk p with the given ring. */
-static double quality_of(const gp_disk *disks, const gp_disk *p, const int32_t *ring,
-                         size_t degree)
-{
-    double h_min = INFINITY, h_max = -INFINITY;
-    for (size_t k = 0; k < degree; k++) {
-        const gp_disk *q = &disks[ring[k]];
-        double h = hypot(q->x - p->x, q->y - p->y) - p->R - q->R;
-        h_min = h < h_min ? h : h_min;
-        h_max = h > h_max ? h : h_max;
-    }
-    return (h_max - h_min) / p->R;
-}
-
-/* Whether the power cell of p, whose ring is closed (p not on the hull), lies in the
- * domain: every power vertex (the weighted circumcentre of a triangle around p) inside.
- * Near a wall the regular triangulation has long thin triangles across the empty space
- * beyond the wall, whose power vertices lie outside the domain; a centre with such a
- * triangle has neighbours only through the outside, not through the free space around
- * it, and F would measure that instead. */
-static int cell_inside_domain(const gp_domain *domain, const gp_disk *disks, const gp_disk *p,
-                              const int32_t *ring, size_t degree)
-{
-    for (size_t k = 0; k < degree; k++) {
-        const gp_disk *a = &disks[ring[k]], *b = &disks[ring[(k + 1) % degree]];
-        /* the power vertex o = p + u solves u.(a - p) = ca and u.(b - p) = cb, where
-         * c = (|q - p|^2 + R_p^2 - R_q^2) / 2 (equal power distance to p and q) */
-        double ax = a->x - p->x, ay = a->y - p->y, bx = b->x - p->x, by = b->y - p->y;
-        double ca = 0.5 * (ax * ax + ay * ay + p->R * p->R - a->R * a->R);
-        double cb = 0.5 * (bx * bx + by * by + p->R * p->R - b->R * b->R);
-        double det = ax * by - ay * bx;
-        if (!(det > 0.0))
-            return 0;
-        double ox = p->x + (ca * by - cb * ay) / det, oy = p->y + (ax * cb - bx * ca) / det;
-        if (!(ox >= 0.0 && oy >= 0.0 && ox <= domain->width && oy <= domain->height))
-            return 0;
-    }
-    return 1;
-}
-
-int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err)
-{
-    memset(stats, 0, sizeof *stats);
-    ring_buffer buf = {malloc(64 * sizeof(int32_t)), 64};
-    double *values = malloc((n ? n : 1) * sizeof *values);
-    int rc = 0;
-    if (!buf.ids || !values) {
-        rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory measuring F on %zu disks", n);
-        goto done;
-    }
-    double sum = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel)) {
-            rc = gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
-            goto done;
-        }
-        int hull;
-        size_t degree = ring_of(rt, (int32_t)i, &buf, &hull);
-        if (degree == (size_t)-1) {
-            rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for a ring");
-            goto done;
-        }
-        values[i] = !hull && degree >= 3 && cell_inside_domain(domain, disks, &disks[i], buf.ids, degree)
-                        ? quality_of(disks, &disks[i], buf.ids, degree)
-                        : NAN;
-        if (isnan(values[i]))
-            continue;
-        if (stats->interior == 0 || values[i] < stats->min)
-            stats->min = values[i];
-        if (stats->interior == 0 || values[i] > stats->max)
-            stats->max = values[i];
-        sum += values[i];
-        stats->interior++;
-    }
-    if (stats->interior) {
-        stats->mean = sum / (double)stats->interior;
-        double span = stats->max - stats->min;
-        for (size_t i = 0; i < n; i++) {
-            if (isnan(values[i]))
-                continue;
-            int bin = span > 0.0 ? (int)((values[i] - stats->min) / span * GP_QUALITY_BINS) : 0;
-            stats->histogram[bin < GP_QUALITY_BINS ? bin : GP_QUALITY_BINS - 1]++;
-        }
-    }
-    if (F)
-        memcpy(F, values, n * sizeof *F);
-done:
-    free(buf.ids);
-    free(values);
-    return rc;
-}
-
 /* Everything one balancing run works with. */
 typedef struct balancer {
     const gp_domain *domain;
     gp_disk *disks;
     size_t n;
-    const gp_rt *rt;
     gp_balance_method method;
     double max_step;
-    gp_grid grid;
-    ring_buffer ring;
-    int32_t *moved; /* ids moved in the current sweep, or restored at the end */
+    rings rings;        /* the rings of the structure the sweep starts from */
+    nearby near;        /* the disks near the positions a centre tries */
+    double *F;          /* F of the structure the sweep starts from (NAN: not interior);
+                           the result's array, which holds F of the best one at the end */
+    uint8_t *changed;   /* rings the last update changed (gp_rt_mark_changes) */
+    uint8_t *stale;     /* F to measure again after the sweep */
+    uint8_t *moved_in;  /* the sweep each centre last moved in, modulo 256 (0: never) */
+    uint8_t sweep;      /* the sweep under way, from 1, modulo 256 */
+    double *tangent;    /* x, y of one centre's tangent positions (x NAN: none) */
+    size_t tangent_cap; /* positions allocated in tangent */
+    int32_t *moved;     /* ids moved in the current sweep, or restored at the end */
     size_t nmoved;
-    double *best;   /* x, y of every centre in the best structure seen */
+    double *best;       /* x, y of every centre in the best structure seen */
 } balancer;
+
+/* Gathers the disks that may overlap the packing disk of `id` placed anywhere in the box
+ * (widened by BOX_MARGIN_RTOL); 0 or GP_ENOMEM. */
+static int gather(balancer *b, int32_t id, double x0, double y0, double x1, double y1)
+{
+    double R = b->disks[id].R;
+    return nearby_gather(&b->near, b->disks, id, R, x0, y0, x1, y1, BOX_MARGIN_RTOL * R);
+}
 
 /* Whether the packing disk of `id` may sit at (x, y): inside the domain and clear of
  * every other disk, with the packer's contact tolerance. */
@@ -163,34 +75,56 @@ static int position_is_free(const balancer *b, int32_t id, double x, double y)
 {
     double R = b->disks[id].R;
     return gp_domain_contains_disk(b->domain, x, y, R, R * GP_CONTACT_RTOL) &&
-           gp_grid_first_overlap(&b->grid, b->disks, x, y, R, id, id) == GP_GRID_NONE;
+           nearby_is_clear(&b->near, b->disks, id, R, x, y);
 }
 
 /* The target of an interior centre: for relocation, the barycentre of the conflict-free
  * positions tangent to the boundary edges of its ball (docs/method.md §4.4); for Laplacian
- * smoothing, the barycentre of its neighbours. Returns 0 when there is none. */
-static int target_of(const balancer *b, int32_t id, const int32_t *ring, size_t degree,
-                     double *tx, double *ty)
+ * smoothing, the barycentre of its neighbours. Gathers the disks near every position the
+ * centre will try. Returns 1, 0 when there is no target, or GP_ENOMEM. */
+static int target_of(balancer *b, int32_t id, const int32_t *ring, size_t degree, double *tx,
+                     double *ty)
 {
-    double sx = 0.0, sy = 0.0;
-    size_t used = 0;
     const gp_disk *p = &b->disks[id];
+    double x0 = p->x, y0 = p->y, x1 = p->x, y1 = p->y, sx = 0.0, sy = 0.0;
+    size_t used = 0;
+    if (b->method == GP_BALANCE_LAPLACIAN) {
+        for (size_t k = 0; k < degree; k++) {
+            sx += b->disks[ring[k]].x;
+            sy += b->disks[ring[k]].y;
+        }
+        *tx = sx / (double)degree;
+        *ty = sy / (double)degree;
+        return gather(b, id, *tx < x0 ? *tx : x0, *ty < y0 ? *ty : y0, *tx > x1 ? *tx : x1,
+                      *ty > y1 ? *ty : y1) ? GP_ENOMEM : 1;
+    }
+    /* a position is two doubles */
+    double *grown = grow(b->tangent, &b->tangent_cap, degree, 2 * sizeof *grown);
+    if (!grown)
+        return GP_ENOMEM;
+    b->tangent = grown;
+    double *t = b->tangent;
     for (size_t k = 0; k < degree; k++) {
-        const gp_disk *q1 = &b->disks[ring[k]];
-        if (b->method == GP_BALANCE_LAPLACIAN) {
-            sx += q1->x;
-            sy += q1->y;
-            used++;
+        /* the link edge (q1, q2) has p on its left: the tangent position on p's side */
+        const gp_disk *q1 = &b->disks[ring[k]], *q2 = &b->disks[ring[(k + 1) % degree]];
+        if (!gp_place_tangent(q1, q2, p->R, &t[2 * k], &t[2 * k + 1])) {
+            t[2 * k] = NAN;
             continue;
         }
-        /* the link edge (q1, q2) has p on its left: the tangent position on p's side */
-        const gp_disk *q2 = &b->disks[ring[(k + 1) % degree]];
-        double x, y;
-        if (gp_place_tangent(q1, q2, p->R, &x, &y) && position_is_free(b, id, x, y)) {
-            sx += x;
-            sy += y;
-            used++;
-        }
+        /* not fmin/fmax: those are calls to libm, they must honour NAN */
+        x0 = t[2 * k] < x0 ? t[2 * k] : x0;
+        x1 = t[2 * k] > x1 ? t[2 * k] : x1;
+        y0 = t[2 * k + 1] < y0 ? t[2 * k + 1] : y0;
+        y1 = t[2 * k + 1] > y1 ? t[2 * k + 1] : y1;
+    }
+    if (gather(b, id, x0, y0, x1, y1))
+        return GP_ENOMEM;
+    for (size_t k = 0; k < degree; k++) {
+        if (isnan(t[2 * k]) || !position_is_free(b, id, t[2 * k], t[2 * k + 1]))
+            continue;
+        sx += t[2 * k];
+        sy += t[2 * k + 1];
+        used++;
     }
     if (!used)
         return 0;
@@ -200,14 +134,15 @@ static int target_of(const balancer *b, int32_t id, const int32_t *ring, size_t 
 }
 
 /* Moves centre `id` the largest conflict-free step toward its target; returns 1 if it
- * moved, 0 if it is settled or blocked (counted in *refused). */
+ * moved, 0 if it is settled or blocked (counted in *refused), or GP_ENOMEM. */
 static int step_centre(balancer *b, int32_t id, const int32_t *ring, size_t degree,
                        uint64_t *refused)
 {
     gp_disk *p = &b->disks[id];
     double tx, ty;
-    if (!target_of(b, id, ring, degree, &tx, &ty))
-        return 0;
+    int rc = target_of(b, id, ring, degree, &tx, &ty);
+    if (rc <= 0)
+        return rc;
     double dx = tx - p->x, dy = ty - p->y, way = hypot(dx, dy);
     for (double w = b->max_step; w > 0.5 * STEP_DECREMENT; w -= STEP_DECREMENT) {
         if (w * way < GP_BALANCE_MIN_STEP_RTOL * p->R)
@@ -215,14 +150,26 @@ static int step_centre(balancer *b, int32_t id, const int32_t *ring, size_t degr
         double x = p->x + w * dx, y = p->y + w * dy;
         if (!position_is_free(b, id, x, y))
             continue;
-        gp_grid_remove(&b->grid, id, p->x, p->y);
+        double old_x = p->x, old_y = p->y;
         p->x = x;
         p->y = y;
-        gp_grid_insert(&b->grid, id, x, y);
+        nearby_move(&b->near, b->disks, id, old_x, old_y);
         return 1;
     }
     (*refused)++;
     return 0;
+}
+
+/* Whether the power cell of interior-looking centre i (not on the hull, three
+ * neighbours or more) lies in the domain now: what its F says, unless a neighbour
+ * moved earlier in this sweep. (A neighbour that moved 256 sweeps ago looks as if it
+ * moved in this one: the cell is then tested again, with the same answer.) */
+static int inside_now(const balancer *b, int32_t i, const int32_t *ring, size_t degree)
+{
+    for (size_t k = 0; k < degree; k++)
+        if (b->moved_in[ring[k]] == b->sweep)
+            return quality_cell_inside(b->domain, b->disks, i, ring, degree);
+    return !isnan(b->F[i]);
 }
 
 static int report(const gp_progress *progress, double fraction, gp_error *err)
@@ -248,18 +195,72 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
             if (rc)
                 return rc;
         }
-        int hull;
-        size_t degree = ring_of(b->rt, (int32_t)i, &b->ring, &hull);
-        if (degree == (size_t)-1)
-            return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for a ring");
-        if (hull || degree < 3 ||
-            !cell_inside_domain(b->domain, b->disks, &b->disks[i], b->ring.ids, degree))
+        size_t degree;
+        const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
+        if (b->rings.hull[i] || degree < 3 || !inside_now(b, (int32_t)i, ring, degree))
             continue;
-        if (step_centre(b, (int32_t)i, b->ring.ids, degree, &out->refused))
+        int rc = step_centre(b, (int32_t)i, ring, degree, &out->refused);
+        if (rc < 0)
+            return gp_error_set(err, rc, NULL, "out of memory balancing disk %zu", i);
+        if (rc) {
             b->moved[b->nmoved++] = (int32_t)i;
+            b->moved_in[i] = b->sweep;
+        }
     }
     out->moves += b->nmoved;
     return 0;
+}
+
+/* Measures F again where it is stale or where the last update changed the ring, then
+ * the whole structure into *stats. Reads *cancel (may be NULL) as gp_quality does, every
+ * GP_QUALITY_CENTRES_PER_CHECK centres: before the sweeps every centre is measured. Returns
+ * 0 or GP_ECANCELED with err. */
+static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp_cancel_flag *cancel,
+                   gp_error *err)
+{
+    for (size_t i = 0; i < b->n; i++) {
+        if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel))
+            return gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
+        if (!b->stale[i] && !b->changed[i])
+            continue;
+        size_t degree;
+        const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
+        b->F[i] = quality_of_centre(b->domain, b->disks, (int32_t)i, ring, degree, b->rings.hull[i]);
+        b->stale[i] = b->changed[i] = 0;
+    }
+    quality_summarise(b->F, b->n, histogram, stats);
+    return 0;
+}
+
+/* The error of a rings_init or rings_refresh that returned rc. */
+static int rings_failed(int rc, size_t n, gp_error *err)
+{
+    return rc == GP_ECANCELED ? gp_error_set(err, rc, NULL, "balancing canceled")
+                              : gp_error_set(err, rc, NULL, "out of memory for the rings of %zu disks", n);
+}
+
+/* Brings the triangulation, the rings and F up to date after the centres in b->moved
+ * moved, and measures the structure into *stats. F is measured again only where it may
+ * have changed: at the centres that moved, at their neighbours (their gaps changed),
+ * and at every centre whose ring the update changed. */
+static int follow_moves(balancer *b, gp_rt *rt, gp_rt_update update, gp_rt_update_stats *counts,
+                        int histogram, const gp_progress *progress, gp_quality_stats *stats,
+                        gp_error *err)
+{
+    const gp_cancel_flag *cancel = gp_progress_cancel(progress);
+    for (size_t m = 0; m < b->nmoved; m++) {
+        size_t degree;
+        const int32_t *ring = rings_of(&b->rings, b->moved[m], &degree);
+        b->stale[b->moved[m]] = 1;
+        for (size_t k = 0; k < degree; k++)
+            b->stale[ring[k]] = 1;
+    }
+    int rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, update, counts, progress, err);
+    if (rc)
+        return rc;
+    if ((rc = rings_refresh(&b->rings, rt, b->changed, cancel)))
+        return rings_failed(rc, b->n, err);
+    return measure(b, histogram, stats, cancel, err);
 }
 
 /* Whether structure `a` is better than `best`: a lower F_max (the report's figure),
@@ -270,6 +271,18 @@ static int improves(const gp_quality_stats *a, const gp_quality_stats *best)
     if (a->max < best->max - GP_BALANCE_QUALITY_TOL)
         return 1;
     return a->max <= best->max && a->mean < best->mean - GP_BALANCE_QUALITY_TOL;
+}
+
+/* Whether the mean F of the last GP_BALANCE_STEADY_SWEEPS + 1 structures (the sweeps'
+ * and the one before them) lie within GP_BALANCE_STEADY_RTOL of `mean`. */
+static int steady(const double *means, double mean)
+{
+    double lo = means[0], hi = means[0];
+    for (int k = 1; k <= GP_BALANCE_STEADY_SWEEPS; k++) {
+        lo = means[k] < lo ? means[k] : lo;
+        hi = means[k] > hi ? means[k] : hi;
+    }
+    return hi - lo < GP_BALANCE_STEADY_RTOL * mean;
 }
 
 static void save_best(balancer *b)
@@ -302,28 +315,45 @@ static double largest_radius(const gp_disk *disks, size_t n)
     return R_max;
 }
 
-/* Sweeps until one moves nothing, the best structure has not improved for
- * GP_BALANCE_STALL_SWEEPS sweeps, or the cap; then returns to the best structure. */
+/* Sets up what the sweeps work with and measures F before them into out->before; reads
+ * the cancel flag of `progress` (may be NULL) while it walks the rings and measures F. */
+static int start_sweeps(balancer *b, gp_rt *rt, const gp_progress *progress, gp_balance_result *out,
+                        gp_error *err)
+{
+    int rc = nearby_init(&b->near, b->domain, b->disks, b->n, largest_radius(b->disks, b->n));
+    if (rc)
+        return gp_error_set(err, rc, NULL, rc == GP_ETOOBIG ? "the bucket grid would be too large"
+                                                           : "out of memory for the bucket grid");
+    if ((rc = rings_init(&b->rings, rt, b->n, progress)))
+        return rings_failed(rc, b->n, err);
+    gp_rt_mark_changes(rt, b->changed);
+    memset(b->stale, 1, b->n);
+    return measure(b, 1, &out->before, gp_progress_cancel(progress), err);
+}
+
+/* Sweeps until one moves nothing, the structure is steady, the best structure has not
+ * improved for GP_BALANCE_STALL_SWEEPS sweeps, or the cap (docs/method.md §4.5); then
+ * returns to the best structure and measures it into out->after and out->F. */
 static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
                       const gp_progress *progress, gp_balance_result *out, gp_error *err)
 {
     uint32_t cap = params->max_iterations ? params->max_iterations : GP_BALANCE_DEFAULT_MAX_ITERATIONS;
-    const gp_cancel_flag *cancel = gp_progress_cancel(progress);
-    /* the grid is as fine as the packer's: about one cell per disk or fewer */
-    int rc = gp_grid_init(&b->grid, b->domain, largest_radius(b->disks, b->n), b->n, 8 * b->n + 1024);
+    int rc = start_sweeps(b, rt, progress, out, err);
     if (rc)
-        return gp_error_set(err, rc, NULL, rc == GP_ETOOBIG ? "the bucket grid would be too large"
-                                                           : "out of memory for the bucket grid");
-    for (size_t i = 0; i < b->n; i++)
-        gp_grid_insert(&b->grid, (int32_t)i, b->disks[i].x, b->disks[i].y);
+        return rc;
     /* `best` is the structure returned; the lowest F_max and the lowest mean seen, even
      * in two different structures, tell whether the sweeps still make progress */
     gp_quality_stats best = out->before, now;
     double lowest_max = best.max, lowest_mean = best.mean;
+    /* the mean F of the last structures (round robin), and when F_max was last lowered */
+    double means[GP_BALANCE_STEADY_SWEEPS + 1];
+    means[0] = out->before.mean;
+    uint32_t lowered_max = 0;
     save_best(b);
     out->stop = GP_BALANCE_STOP_CAP;
     for (uint32_t stall = 0; out->sweeps < cap;) {
         double share = 1.0 / cap;
+        b->sweep = (uint8_t)(out->sweeps + 1);
         if ((rc = sweep(b, progress, share * out->sweeps, share, out, err)))
             return rc;
         out->sweeps++;
@@ -331,17 +361,24 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
             out->stop = GP_BALANCE_STOP_CONVERGED;
             break;
         }
-        if ((rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, params->update,
-                                     &out->triangulation, progress, err)) ||
-            (rc = gp_quality(b->domain, rt, b->disks, b->n, NULL, &now, cancel, err)) ||
+        if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 0, progress, &now, err)) ||
             (rc = report(progress, share * out->sweeps, err)))
             return rc;
+        nearby_sort(&b->near, b->disks);
         if (improves(&now, &best)) {
             best = now;
             out->best_sweep = out->sweeps;
             save_best(b);
         }
-        if (now.max < lowest_max - GP_BALANCE_QUALITY_TOL || now.mean < lowest_mean - GP_BALANCE_QUALITY_TOL)
+        int lower_max = now.max < lowest_max - GP_BALANCE_QUALITY_TOL;
+        lowered_max = lower_max ? out->sweeps : lowered_max;
+        means[out->sweeps % (GP_BALANCE_STEADY_SWEEPS + 1)] = now.mean;
+        if (b->method == GP_BALANCE_RELOCATION && out->sweeps - lowered_max >= GP_BALANCE_STEADY_SWEEPS &&
+            steady(means, now.mean)) {
+            out->stop = GP_BALANCE_STOP_STEADY;
+            break;
+        }
+        if (lower_max || now.mean < lowest_mean - GP_BALANCE_QUALITY_TOL)
             stall = 0;
         else if (++stall >= GP_BALANCE_STALL_SWEEPS) {
             out->stop = GP_BALANCE_STOP_STALLED;
@@ -351,8 +388,9 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
         lowest_mean = now.mean < lowest_mean ? now.mean : lowest_mean;
     }
     restore_best(b);
-    return gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, params->update,
-                              &out->triangulation, progress, err);
+    if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, progress, &out->after, err)))
+        return rc;
+    return 0;
 }
 
 int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
@@ -365,34 +403,47 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
     b.domain = domain;
     b.disks = disks;
     b.n = n;
-    b.rt = rt;
     b.method = params->method;
     b.max_step = params->max_step > 0.0 ? params->max_step : GP_BALANCE_DEFAULT_MAX_STEP;
     out->method = params->method;
     out->max_step = b.max_step;
     out->count = n;
-    out->F = malloc((n ? n : 1) * sizeof *out->F);
-    b.ring.cap = 64;
-    b.ring.ids = malloc(b.ring.cap * sizeof *b.ring.ids);
-    b.moved = malloc((n ? n : 1) * sizeof *b.moved);
-    b.best = malloc((n ? 2 * n : 1) * sizeof *b.best);
+    out->stop = GP_BALANCE_STOP_CONVERGED;
+    size_t m = n ? n : 1;
     int rc = 0;
-    if (!out->F || !b.ring.ids || !b.moved || !b.best) {
+    out->F = malloc(m * sizeof *out->F);
+    if (!out->F) {
         rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", n);
         goto done;
     }
-    if ((rc = gp_quality(domain, rt, disks, n, NULL, &out->before, gp_progress_cancel(progress), err)))
-        goto done;
-    out->stop = GP_BALANCE_STOP_CONVERGED;
-    if (params->method != GP_BALANCE_NONE && n > 0 &&
-        (rc = run_sweeps(&b, rt, params, progress, out, err)))
-        goto done;
-    rc = gp_quality(domain, rt, disks, n, out->F, &out->after, gp_progress_cancel(progress), err);
-    if (rc == 0 && progress && progress->report)
+    if (params->method == GP_BALANCE_NONE || n == 0) {
+        if ((rc = gp_quality(domain, rt, disks, n, out->F, &out->before, gp_progress_cancel(progress), err)))
+            goto done;
+        out->after = out->before;
+    } else {
+        b.F = out->F;
+        b.changed = calloc(m, 1);
+        b.stale = calloc(m, 1);
+        b.moved_in = calloc(m, sizeof *b.moved_in);
+        b.moved = malloc(m * sizeof *b.moved);
+        b.best = malloc(2 * m * sizeof *b.best);
+        if (!b.changed || !b.stale || !b.moved_in || !b.moved || !b.best) {
+            rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", n);
+            goto done;
+        }
+        if ((rc = run_sweeps(&b, rt, params, progress, out, err)))
+            goto done;
+    }
+    if (progress && progress->report)
         progress->report(progress->ctx, "balance", 1.0);
 done:
-    gp_grid_free(&b.grid);
-    free(b.ring.ids);
+    gp_rt_mark_changes(rt, NULL);
+    nearby_free(&b.near);
+    rings_free(&b.rings);
+    free(b.changed);
+    free(b.stale);
+    free(b.moved_in);
+    free(b.tangent);
     free(b.moved);
     free(b.best);
     if (rc)
@@ -411,6 +462,7 @@ const char *gp_balance_stop_name(gp_balance_stop stop)
     switch (stop) {
     case GP_BALANCE_STOP_CONVERGED: return "converged";
     case GP_BALANCE_STOP_STALLED: return "stalled";
+    case GP_BALANCE_STOP_STEADY: return "steady";
     case GP_BALANCE_STOP_CAP: return "max_iterations";
     }
     return "?";

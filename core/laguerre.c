@@ -141,8 +141,9 @@ typedef struct builder {
     size_t labels_cap;
     int32_t *doubtful; /* pairs (i, j) whose shared edge is near the tolerance */
     size_t ndoubtful, doubtful_cap;
-    int32_t *ring;
-    size_t ring_cap;
+    size_t *ring_start; /* every ring, from gp_rt_rings */
+    int32_t *rings;
+    const int32_t *ring; /* the ring of the cell being built */
     half_plane *hp;  /* the radical half-plane of each ring neighbour */
     size_t hp_cap;
     gp_cells *out;
@@ -156,16 +157,8 @@ typedef struct builder {
 static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
 {
     const gp_disk *p = &bd->disks[i];
-    int hull;
-    for (;;) {
-        *degree = gp_rt_ring(bd->rt, i, bd->ring, bd->ring_cap, &hull);
-        if (*degree <= bd->ring_cap)
-            break;
-        int32_t *ring = grow(bd->ring, &bd->ring_cap, *degree, sizeof *ring);
-        if (!ring)
-            return GP_ENOMEM;
-        bd->ring = ring;
-    }
+    bd->ring = bd->rings + bd->ring_start[i];
+    *degree = bd->ring_start[i + 1] - bd->ring_start[i];
     /* the cell has at most the four walls and one edge per neighbour (m <= degree + 4);
      * while it is shrunk, at most its m edges and their m moved copies */
     size_t m = *degree + 4;
@@ -355,15 +348,16 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
     out->nstart = calloc(n + 1, sizeof *out->nstart);
     out->area = malloc((n ? n : 1) * sizeof *out->area);
     /* room for the usual: six neighbours and seven vertices a cell; grown if needed */
-    bd.ring_cap = 64;
-    bd.ring = malloc(bd.ring_cap * sizeof *bd.ring);
     bd.xy_cap = 16 * n + 16;
     out->xy = malloc(bd.xy_cap * sizeof *out->xy);
     bd.nb_cap = 7 * n + 16;
     out->neighbours = malloc(bd.nb_cap * sizeof *out->neighbours);
+    bd.ring_start = malloc((n + 1) * sizeof *bd.ring_start);
     int rc = 0;
-    if (!out->start || !out->nstart || !out->area || !bd.ring || !out->xy || !out->neighbours) {
-        rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells of %zu disks", n);
+    if (!out->start || !out->nstart || !out->area || !out->xy || !out->neighbours || !bd.ring_start ||
+        (rc = gp_rt_rings(rt, bd.ring_start, NULL, &bd.rings, progress))) {
+        rc = rc == GP_ECANCELED ? gp_error_set(err, GP_ECANCELED, NULL, "laguerre cells canceled")
+                                : gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells of %zu disks", n);
         goto done;
     }
     for (size_t i = 0; i < n; i++) {
@@ -386,7 +380,8 @@ done:
     free(bd.a.label);
     free(bd.b.u);
     free(bd.b.label);
-    free(bd.ring);
+    free(bd.ring_start);
+    free(bd.rings);
     free(bd.hp);
     free(bd.labels);
     free(bd.doubtful);

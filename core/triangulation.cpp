@@ -9,7 +9,9 @@
 #include <CGAL/spatial_sort.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <new>
 #include <utility>
@@ -44,9 +46,28 @@ struct gp_rt {
     Rt rt;
     std::vector<Vertex_handle> vertex;                // by disk id
     std::vector<std::pair<Face_handle, int>> edges;   // the flip stack, kept between moves
+    uint8_t *marks = nullptr;                         // borrowed: see gp_rt_mark_changes
 };
 
 namespace {
+
+// Marks the ring of finite vertex v as changed, when the caller asked for marks.
+void mark(const gp_rt &t, Vertex_handle v)
+{
+    if (t.marks && !t.rt.is_infinite(v))
+        t.marks[v->info()] = 1;
+}
+
+// Marks v and every finite vertex around it.
+void mark_star(const gp_rt &t, Vertex_handle v)
+{
+    mark(t, v);
+    Rt::Vertex_circulator c = t.rt.incident_vertices(v), done = c;
+    if (c != nullptr)
+        do
+            mark(t, c);
+        while (++c != done);
+}
 
 // Comparisons of the spatial sort between two reads of the cancel flag: well under a
 // millisecond of work.
@@ -146,6 +167,8 @@ int build_into(gp_rt &t, const gp_disk *disks, size_t n, const gp_progress *prog
                                 "regular triangulation: two vertices claim disk %d", id);
         t.vertex[id] = v;
     }
+    if (t.marks)
+        std::fill(t.marks, t.marks + n, uint8_t(1));
     for (size_t i = 0; i < n; i++)
         if (t.vertex[i] == Vertex_handle())
             return gp_error_set(err, GP_EGEOM, NULL,
@@ -155,12 +178,46 @@ int build_into(gp_rt &t, const gp_disk *disks, size_t n, const gp_progress *prog
     return 0;
 }
 
+// A power test computed in doubles is trusted when it exceeds this fraction of the sum
+// of the absolute values of its terms. Why this value: with every input difference
+// rounded once, the determinant's rounding error stays below about 20 ulps of that sum
+// (2e-15 of it); 1e-12 leaves a margin of hundreds, and a test too close to call goes to
+// CGAL's exact predicate, so the answer is always the exact one.
+const double POWER_TEST_FILTER = 1e-12;
+
+// rt.power_test(f, t) for a finite face f, the sign of CGAL's determinant
+// (power_side_of_oriented_power_circleC2, translated to t), first in plain doubles.
+// CGAL's own filter evaluates it in interval arithmetic, switching the FPU rounding mode
+// each time: a third of the updates' time. Exact either way.
+CGAL::Oriented_side power_test(const Rt &rt, Face_handle f, const Weighted_point &t)
+{
+    const Weighted_point &p = f->vertex(0)->point(), &q = f->vertex(1)->point(), &r = f->vertex(2)->point();
+    double tx = t.x(), ty = t.y(), tw = t.weight();
+    double px = p.x() - tx, py = p.y() - ty, pz = px * px + py * py - p.weight() + tw;
+    double qx = q.x() - tx, qy = q.y() - ty, qz = qx * qx + qy * qy - q.weight() + tw;
+    double rx = r.x() - tx, ry = r.y() - ty, rz = rx * rx + ry * ry - r.weight() + tw;
+    // the lifted coordinates' size before cancellation, for the error bound
+    double pa = px * px + py * py + std::fabs(p.weight()) + std::fabs(tw);
+    double qa = qx * qx + qy * qy + std::fabs(q.weight()) + std::fabs(tw);
+    double ra = rx * rx + ry * ry + std::fabs(r.weight()) + std::fabs(tw);
+    double det = px * (qy * rz - qz * ry) - py * (qx * rz - qz * rx) + pz * (qx * ry - qy * rx);
+    double bound = std::fabs(px) * (std::fabs(qy) * ra + qa * std::fabs(ry)) +
+                   std::fabs(py) * (std::fabs(qx) * ra + qa * std::fabs(rx)) +
+                   pa * (std::fabs(qx * ry) + std::fabs(qy * rx));
+    if (det > POWER_TEST_FILTER * bound)
+        return CGAL::ON_POSITIVE_SIDE;
+    if (det < -POWER_TEST_FILTER * bound)
+        return CGAL::ON_NEGATIVE_SIDE;
+    return rt.power_test(f, t);
+}
+
 // Lawson's flips from the edges of the faces around v until every edge they reach is
 // locally regular. Returns false when a non-regular edge cannot be flipped (its
 // quadrilateral is not convex) or the flips run away.
-bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int>> &stack,
-                 gp_rt_update_stats &stats)
+bool flip_around(gp_rt &t, Vertex_handle v, gp_rt_update_stats &stats)
 {
+    Rt &rt = t.rt;
+    std::vector<std::pair<Face_handle, int>> &stack = t.edges;
     // every edge whose two triangles have v as a vertex: the link edge and one spoke of
     // each triangle around v (the other spoke is the next triangle's)
     stack.clear();
@@ -179,7 +236,7 @@ bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int
         if (rt.is_infinite(f) || rt.is_infinite(g))
             continue; // hull edges: the hull does not change, see gp_rt_update_moved
         const Weighted_point &d = g->vertex(g->index(f))->point();
-        if (rt.power_test(f, d) != CGAL::ON_POSITIVE_SIDE)
+        if (power_test(rt, f, d) != CGAL::ON_POSITIVE_SIDE)
             continue; // locally regular (or exactly co-power-circular: either diagonal)
         const Weighted_point &a = f->vertex(i)->point();
         const Weighted_point &b = f->vertex(Rt::ccw(i))->point();
@@ -188,6 +245,11 @@ bool flip_around(Rt &rt, Vertex_handle v, std::vector<std::pair<Face_handle, int
             return false;
         if (++flips > MAX_FLIPS_PER_MOVE)
             return false;
+        // the four vertices of the quadrilateral gain or lose a neighbour
+        mark(t, f->vertex(i));
+        mark(t, f->vertex(Rt::ccw(i)));
+        mark(t, f->vertex(Rt::cw(i)));
+        mark(t, g->vertex(g->index(f)));
         rt.flip(f, i);
         stats.flips++;
         for (int j = 0; j < 3; j++) {
@@ -224,9 +286,12 @@ move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_u
     if (can_move_in_place(t.rt, v, wp.point())) {
         v->set_point(wp);
         stats.moved_in_place++;
-        return flip_around(t.rt, v, t.edges, stats) ? MOVED : NEEDS_REBUILD;
+        return flip_around(t, v, stats) ? MOVED : NEEDS_REBUILD;
     }
-    // remove and insert again: the triangulation stays regular throughout
+    // remove and insert again: the triangulation stays regular throughout. Removing
+    // retriangulates the hole among v's neighbours; inserting flips only edges whose
+    // ends end up around the new vertex: those are all the rings that change.
+    mark_star(t, v);
     Vertex_handle near;
     Rt::Vertex_circulator c = t.rt.incident_vertices(v), done = c;
     do
@@ -238,6 +303,7 @@ move_outcome move_vertex(gp_rt &t, int32_t id, const Weighted_point &wp, gp_rt_u
         return NEEDS_REBUILD; // the rebuild names the disk
     w->info() = id;
     t.vertex[id] = w;
+    mark_star(t, w);
     stats.reinserted++;
     return MOVED;
 }
@@ -288,11 +354,11 @@ extern "C" int gp_rt_dimension(const gp_rt *rt) noexcept
     return rt->rt.dimension();
 }
 
-extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
-                             int *hull) noexcept
+namespace {
+
+// The ring of v as gp_rt_ring gives it (see there).
+size_t ring_of(const Rt &r, Vertex_handle v, int32_t *out, size_t cap, int *hull)
 {
-    const Rt &r = rt->rt;
-    Vertex_handle v = rt->vertex[id];
     *hull = 1;
     if (r.dimension() < 1)
         return 0;
@@ -333,6 +399,57 @@ extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t c
         first = static_cast<size_t>(std::min_element(out, out + n) - out);
     std::rotate(out, out + first, out + n);
     return n;
+}
+
+} // namespace
+
+extern "C" size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
+                             int *hull) noexcept
+{
+    return ring_of(rt->rt, rt->vertex[id], out, cap, hull);
+}
+
+extern "C" int gp_rt_rings(const gp_rt *rt, size_t *start, uint8_t *hull, int32_t **ids,
+                           const gp_progress *progress) noexcept
+{
+    const gp_cancel_flag *cancel = gp_progress_cancel(progress);
+    size_t walked = 0;
+    const Rt &r = rt->rt;
+    size_t n = rt->vertex.size();
+    *ids = NULL;
+    // both passes walk the vertices in the triangulation's memory order: a vertex and
+    // its faces were allocated together, so the walk stays in cache, where visiting them
+    // by id jumps across the whole triangulation for every ring
+    std::fill(start, start + n + 1, size_t(0));
+    for (Rt::Finite_vertices_iterator v = r.finite_vertices_begin(); v != r.finite_vertices_end(); ++v) {
+        if (++walked % GP_RT_RINGS_PER_CHECK == 0 && gp_canceled(cancel))
+            return GP_ECANCELED;
+        int on_hull;
+        start[v->info() + 1] = ring_of(r, v, NULL, 0, &on_hull);
+    }
+    for (size_t i = 0; i < n; i++)
+        start[i + 1] += start[i];
+    int32_t *out = static_cast<int32_t *>(malloc((start[n] ? start[n] : 1) * sizeof *out));
+    if (!out)
+        return GP_ENOMEM;
+    for (Rt::Finite_vertices_iterator v = r.finite_vertices_begin(); v != r.finite_vertices_end(); ++v) {
+        if (++walked % GP_RT_RINGS_PER_CHECK == 0 && gp_canceled(cancel)) {
+            free(out);
+            return GP_ECANCELED;
+        }
+        int32_t id = v->info();
+        int on_hull;
+        ring_of(r, v, out + start[id], start[id + 1] - start[id], &on_hull);
+        if (hull)
+            hull[id] = static_cast<uint8_t>(on_hull);
+    }
+    *ids = out;
+    return 0;
+}
+
+extern "C" void gp_rt_mark_changes(gp_rt *rt, uint8_t *marks) noexcept
+{
+    rt->marks = marks;
 }
 
 extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks,

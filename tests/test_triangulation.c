@@ -1,8 +1,9 @@
 /* test_triangulation.c - the regular triangulation module: rings counter-clockwise with
  * the hull where the header says, the empty-power-circle property checked by brute force,
- * hidden vertices reported, degenerate inputs, and updates after moves (flips, reinsertion,
- * rebuild) that end in the same triangulation as a fresh build; a raised cancel flag stops
- * a build, an update and a rebuild. */
+ * hidden vertices reported, degenerate inputs, all the rings at once, and updates after
+ * moves (flips, reinsertion, rebuild) that end in the same triangulation as a fresh build
+ * and mark every ring they change, and stay regular through moves of a few ulps; a raised
+ * cancel flag stops a build, an update, a rebuild and the walk of all the rings. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -204,6 +205,92 @@ static size_t count_ring_differences(const gp_rt *a, const gp_rt *b, size_t n)
     return differ;
 }
 
+/* Checks gp_rt_rings against gp_rt_ring vertex by vertex: the same rings, in the same
+ * order from the same start, and the same hull flags. */
+static void check_all_rings(const gp_rt *rt, size_t n)
+{
+    size_t *start = malloc((n + 1) * sizeof *start);
+    uint8_t *hull = malloc(n ? n : 1);
+    int32_t *ids;
+    CHECK(gp_rt_rings(rt, start, hull, &ids, NULL) == 0);
+    size_t wrong = 0;
+    for (size_t i = 0; i < n; i++) {
+        int32_t nb[64];
+        int h;
+        size_t deg = ring(rt, (int32_t)i, nb, &h);
+        int same = start[i + 1] - start[i] == deg && hull[i] == h;
+        for (size_t k = 0; k < deg && same; k++)
+            same = ids[start[i] + k] == nb[k];
+        wrong += !same;
+    }
+    CHECK_MSG(wrong == 0, "%zu of %zu rings differ", wrong, n);
+    free(ids);
+    free(start);
+    free(hull);
+}
+
+/* Every ring of rt as gp_rt_ring gives it, end to end, with each ring's start. */
+typedef struct ring_copy {
+    size_t *start;
+    int32_t *ids;
+    int *hull;
+} ring_copy;
+
+static ring_copy copy_rings(const gp_rt *rt, size_t n)
+{
+    ring_copy c = {malloc((n + 1) * sizeof(size_t)), malloc(64 * (n ? n : 1) * sizeof(int32_t)),
+                   malloc((n ? n : 1) * sizeof(int))};
+    c.start[0] = 0;
+    for (size_t i = 0; i < n; i++)
+        c.start[i + 1] = c.start[i] + ring(rt, (int32_t)i, c.ids + c.start[i], &c.hull[i]);
+    return c;
+}
+
+static void free_rings(ring_copy *c)
+{
+    free(c->start);
+    free(c->ids);
+    free(c->hull);
+}
+
+/* The vertices whose ring differs between a and b that `marks` leaves unmarked. */
+static size_t unmarked_changes(const ring_copy *a, const ring_copy *b, const uint8_t *marks, size_t n)
+{
+    size_t missed = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t da = a->start[i + 1] - a->start[i], db = b->start[i + 1] - b->start[i];
+        int same = da == db && a->hull[i] == b->hull[i] &&
+                   memcmp(a->ids + a->start[i], b->ids + b->start[i], da * sizeof *a->ids) == 0;
+        missed += !same && !marks[i];
+    }
+    return missed;
+}
+
+static void test_all_rings_at_once_are_the_rings_one_by_one(void)
+{
+    gp_spec spec;
+    load_example("iron", &spec);
+    gp_packing pk;
+    gp_error err;
+    pack_seed(&spec, 2, &pk);
+    gp_rt *rt;
+    CHECK(gp_rt_build(pk.disks, pk.count, NULL, &rt, &err) == 0);
+    check_all_rings(rt, pk.count);
+    gp_rt_free(rt);
+    /* a patch with its hull, a row (dimension 1), one disk, none */
+    gp_disk d[49];
+    size_t n = hex_patch(d, 7, 7, 0.0, 0.0);
+    for (size_t m = 0; m <= n; m = m < 8 ? m + 1 : n) {
+        CHECK(gp_rt_build(d, m, NULL, &rt, &err) == 0);
+        check_all_rings(rt, m);
+        gp_rt_free(rt);
+        if (m == n)
+            break;
+    }
+    gp_packing_free(&pk);
+    gp_spec_free(&spec);
+}
+
 static void test_updates_after_moves_match_a_fresh_build(void)
 {
     gp_spec spec;
@@ -221,8 +308,11 @@ static void test_updates_after_moves_match_a_fresh_build(void)
     gp_rng rng;
     gp_rng_seed(&rng, 7);
     int32_t *ids = malloc(pk.count * sizeof *ids);
+    uint8_t *marks = calloc(pk.count, 1);
+    gp_rt_mark_changes(rt, marks);
     gp_rt_update_stats st = {0, 0, 0, 0};
     for (int round = 0; round < 3; round++) {
+        ring_copy before = copy_rings(rt, pk.count);
         size_t moved = 0;
         for (size_t i = 0; i < pk.count; i += 2) {
             double step = (round == 2 ? 1.2 : 0.3) * pk.disks[i].R;
@@ -232,6 +322,18 @@ static void test_updates_after_moves_match_a_fresh_build(void)
         }
         CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, moved, GP_RT_UPDATE_FLIPS, &st, NULL, &err) == 0);
         CHECK(gp_rt_is_regular(rt));
+        check_all_rings(rt, pk.count);
+        /* every ring the update changed is marked, and not every ring is: a disk far
+         * from the moves keeps its ring */
+        ring_copy after = copy_rings(rt, pk.count);
+        size_t marked = 0;
+        for (size_t i = 0; i < pk.count; i++)
+            marked += marks[i];
+        CHECK_MSG(unmarked_changes(&before, &after, marks, pk.count) == 0, "round %d", round);
+        CHECK_MSG(marked > 0 && marked < pk.count, "round %d: %zu of %zu marked", round, marked, pk.count);
+        memset(marks, 0, pk.count);
+        free_rings(&before);
+        free_rings(&after);
         CHECK(gp_rt_build(pk.disks, pk.count, NULL, &fresh, &err) == 0);
         CHECK_MSG(count_ring_differences(rt, fresh, pk.count) == 0, "round %d", round);
         gp_rt_free(fresh);
@@ -243,10 +345,54 @@ static void test_updates_after_moves_match_a_fresh_build(void)
     gp_rt_update_stats rb = {0, 0, 0, 0};
     CHECK(gp_rt_update_moved(rt, pk.disks, pk.count, ids, 1, GP_RT_UPDATE_REBUILD, &rb, NULL, &err) == 0);
     CHECK(rb.rebuilds == 1 && gp_rt_is_regular(rt));
+    /* a rebuild marks every vertex */
+    size_t marked = 0;
+    for (size_t i = 0; i < pk.count; i++)
+        marked += marks[i];
+    CHECK(marked == pk.count);
+    gp_rt_mark_changes(rt, NULL);
+    free(marks);
     free(ids);
     gp_rt_free(rt);
     gp_packing_free(&pk);
     gp_spec_free(&spec);
+}
+
+/* Moves of a few ulps on a square grid, where every four neighbours share a power circle
+ * exactly: the power tests of the flips are as close to zero as doubles allow, where a
+ * test computed in doubles alone would misjudge the sign; the update must still end in a
+ * regular triangulation (checked with CGAL's exact predicates). */
+static void test_updates_stay_regular_on_near_ties(void)
+{
+    enum { SIDE = 8 };
+    /* a pitch and an origin that doubles do not hold exactly: the lifted coordinates of
+     * the tests are rounded, and their errors are of the size of the moves */
+    const double pitch = 0.3, x0 = 10.1, y0 = 20.7;
+    gp_disk d[SIDE * SIDE];
+    for (int i = 0; i < SIDE * SIDE; i++)
+        d[i] = (gp_disk){x0 + pitch * (i % SIDE), y0 + pitch * (i / SIDE), 0.13, 0.13};
+    gp_rt *rt;
+    gp_error err;
+    CHECK(gp_rt_build(d, SIDE * SIDE, NULL, &rt, &err) == 0);
+    gp_rng rng;
+    gp_rng_seed(&rng, 11);
+    int32_t ids[SIDE * SIDE];
+    for (int round = 0; round < 40; round++) {
+        size_t moved = 0;
+        for (int i = 0; i < SIDE * SIDE; i++) {
+            if (gp_rng_uniform(&rng) < 0.5)
+                continue;
+            /* back to the grid every fourth round (ties), else up to 3 ulps of 16 off it */
+            double ulp = 0x1p-48, kx = round % 4 ? floor(7.0 * gp_rng_uniform(&rng)) - 3.0 : 0.0,
+                   ky = round % 4 ? floor(7.0 * gp_rng_uniform(&rng)) - 3.0 : 0.0;
+            d[i].x = x0 + pitch * (i % SIDE) + kx * ulp;
+            d[i].y = y0 + pitch * (i / SIDE) + ky * ulp;
+            ids[moved++] = i;
+        }
+        CHECK(gp_rt_update_moved(rt, d, SIDE * SIDE, ids, moved, GP_RT_UPDATE_FLIPS, NULL, NULL, &err) == 0);
+        CHECK_MSG(gp_rt_is_regular(rt), "round %d", round);
+    }
+    gp_rt_free(rt);
 }
 
 /* A progress callback that counts its calls, checks the fractions rise, and raises the
@@ -304,6 +450,16 @@ static void test_a_raised_flag_stops_builds_updates_and_measures(void)
     CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     CHECK(gp_rt_update_moved(rt, d, n, ids, 1, GP_RT_UPDATE_REBUILD, NULL, &canceled, &err) == GP_ECANCELED);
     gp_rt_free(rt);
+    /* the walk of all the rings (10^4 vertices: a check every GP_RT_RINGS_PER_CHECK of
+     * its 2 * 10^4 steps) stops too, and hands back no array */
+    CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
+    size_t *start = malloc((n + 1) * sizeof *start);
+    int32_t *rings = (int32_t *)&raised; /* must come back NULL */
+    CHECK(gp_rt_rings(rt, start, NULL, &rings, &canceled) == GP_ECANCELED && rings == NULL);
+    CHECK(gp_rt_rings(rt, start, NULL, &rings, NULL) == 0 && rings != NULL);
+    free(rings);
+    free(start);
+    gp_rt_free(rt);
     free(ids);
     free(d);
 }
@@ -314,7 +470,9 @@ int main(void)
     RUN(test_triangles_have_empty_power_circles_by_brute_force);
     RUN(test_hidden_and_duplicate_disks_are_geometry_errors);
     RUN(test_degenerate_inputs_have_rings_too);
+    RUN(test_all_rings_at_once_are_the_rings_one_by_one);
     RUN(test_updates_after_moves_match_a_fresh_build);
+    RUN(test_updates_stay_regular_on_near_ties);
     RUN(test_a_raised_flag_stops_builds_updates_and_measures);
     return check_status();
 }

@@ -1,0 +1,193 @@
+/* nearby.c - the disks near the positions a balancing sweep tries: a cell-sorted copy of
+ * the disks plus the lists of those moved since (see nearby.h). */
+#include "nearby.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grainpack/error.h"
+#include "grow.h"
+
+/* A grid of about one cell per disk or fewer, as the packer's. */
+#define CELLS_PER_DISK 8
+
+static int reserve(nearby *nb, size_t need);
+
+int nearby_init(nearby *nb, const gp_domain *domain, const gp_disk *disks, size_t n, double R_max)
+{
+    memset(nb, 0, sizeof *nb);
+    if (n > (size_t)INT32_MAX)
+        return GP_ETOOBIG;
+    int rc = gp_grid_init(&nb->grid, domain, R_max, n, CELLS_PER_DISK * n + 1024);
+    if (rc)
+        return rc;
+    size_t m = n ? n : 1;
+    nb->n = n;
+    nb->start = malloc((nb->grid.ncells + 1) * sizeof *nb->start);
+    nb->sorted = malloc(m * sizeof *nb->sorted);
+    nb->entry = malloc(m * sizeof *nb->entry);
+    if (!nb->start || !nb->sorted || !nb->entry || reserve(nb, 64)) {
+        nearby_free(nb);
+        return GP_ENOMEM;
+    }
+    nearby_sort(nb, disks);
+    return 0;
+}
+
+void nearby_sort(nearby *nb, const gp_disk *disks)
+{
+    gp_grid *g = &nb->grid;
+    memset(g->head, 0xff, g->ncells * sizeof *g->head); /* the lists: all GP_GRID_NONE */
+    /* a counting sort: start[c + 1] counts cell c, then the running sums place each disk */
+    memset(nb->start, 0, (g->ncells + 1) * sizeof *nb->start);
+    for (size_t i = 0; i < nb->n; i++)
+        nb->start[gp_grid_cell(g, disks[i].x, disks[i].y) + 1]++;
+    for (size_t c = 0; c < g->ncells; c++)
+        nb->start[c + 1] += nb->start[c];
+    for (size_t i = 0; i < nb->n; i++) {
+        uint32_t e = nb->start[gp_grid_cell(g, disks[i].x, disks[i].y)]++;
+        nb->sorted[e] = (nearby_entry){disks[i].x, disks[i].y, disks[i].R, (int64_t)i};
+        nb->entry[i] = e;
+    }
+    /* each start[c] has moved on to the start of cell c + 1: shift back */
+    memmove(nb->start + 1, nb->start, g->ncells * sizeof *nb->start);
+    nb->start[0] = 0;
+}
+
+void nearby_move(nearby *nb, const gp_disk *disks, int32_t id, double old_x, double old_y)
+{
+    nearby_entry *e = &nb->sorted[nb->entry[id]];
+    if (isinf(e->x))
+        gp_grid_remove(&nb->grid, id, old_x, old_y);
+    else
+        e->x = INFINITY; /* out of reach of every box: never gathered again */
+    gp_grid_insert(&nb->grid, id, disks[id].x, disks[id].y);
+}
+
+/* Room for `need` gathered disks; 0 or GP_ENOMEM. */
+static int reserve(nearby *nb, size_t need)
+{
+    if (need <= nb->gcap)
+        return 0;
+    size_t cap = grow_capacity(nb->gcap, need);
+    double *gx = cap ? grow_realloc(nb->gx, cap, sizeof *gx) : NULL;
+    if (gx)
+        nb->gx = gx;
+    double *gy = gx ? grow_realloc(nb->gy, cap, sizeof *gy) : NULL;
+    if (gy)
+        nb->gy = gy;
+    double *gR = gy ? grow_realloc(nb->gR, cap, sizeof *gR) : NULL;
+    if (!gR)
+        return GP_ENOMEM;
+    nb->gR = gR;
+    nb->gcap = cap;
+    return 0;
+}
+
+/* Appends a disk to the gathered ones when `keep` (room reserved): written either way,
+ * counted only if kept, so that the loops around it have no branch to mispredict. */
+static void keep_if(nearby *nb, double x, double y, double R, int keep)
+{
+    nb->gx[nb->gn] = x;
+    nb->gy[nb->gn] = y;
+    nb->gR[nb->gn] = R;
+    nb->gn += (size_t)keep;
+}
+
+static double clamp(double v, double lo, double hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+/* Whether a disk of radius Rq at (x, y) is closer than R + Rq to the box. */
+static int near_box(const nearby *nb, double x, double y, double Rq, double R)
+{
+    double dx = x - clamp(x, nb->x0, nb->x1), dy = y - clamp(y, nb->y0, nb->y1), r = R + Rq;
+    return dx * dx + dy * dy < r * r;
+}
+
+int nearby_gather(nearby *nb, const gp_disk *disks, int32_t id, double R, double x0, double y0,
+                  double x1, double y1, double margin)
+{
+    const gp_grid *g = &nb->grid;
+    nb->x0 = x0 - margin;
+    nb->y0 = y0 - margin;
+    nb->x1 = x1 + margin;
+    nb->y1 = y1 + margin;
+    nb->gn = 0;
+    /* a disk that overlaps a disk of radius R in the box has its centre within
+     * R + R_max = R + cell / 2 of the box */
+    double reach = R + 0.5 * g->cell;
+    int32_t ix0, iy0, ix1, iy1;
+    gp_grid_coords(g, nb->x0 - reach, nb->y0 - reach, &ix0, &iy0);
+    gp_grid_coords(g, nb->x1 + reach, nb->y1 + reach, &ix1, &iy1);
+    for (int32_t iy = iy0; iy <= iy1; iy++) {
+        size_t first = gp_grid_index(g, ix0, iy), last = gp_grid_index(g, ix1, iy);
+        uint32_t lo = nb->start[first], hi = nb->start[last + 1];
+        if (reserve(nb, nb->gn + (hi - lo)))
+            return GP_ENOMEM;
+        for (const nearby_entry *e = nb->sorted + lo; e < nb->sorted + hi; e++)
+            keep_if(nb, e->x, e->y, e->R, near_box(nb, e->x, e->y, e->R, R) & (e->id != id));
+        for (size_t c = first; c <= last; c++)
+            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->next[j]) {
+                if (reserve(nb, nb->gn + 1))
+                    return GP_ENOMEM;
+                keep_if(nb, disks[j].x, disks[j].y, disks[j].R, near_box(nb, disks[j].x, disks[j].y, disks[j].R, R) & (j != id));
+            }
+    }
+    return 0;
+}
+
+/* gp_grid_first_overlap's predicate: the centres closer than (R + Rq)(1 - GP_CONTACT_RTOL). */
+static int overlaps(double dx, double dy, double Rq, double R)
+{
+    double reach = (Rq + R) * (1.0 - GP_CONTACT_RTOL);
+    return !(dx * dx + dy * dy >= reach * reach);
+}
+
+int nearby_is_clear(const nearby *nb, const gp_disk *disks, int32_t id, double R, double x, double y)
+{
+    if (x >= nb->x0 && x <= nb->x1 && y >= nb->y0 && y <= nb->y1) {
+        /* every disk, without a branch: the loop runs two disks at a time */
+        const double *gx = nb->gx, *gy = nb->gy, *gR = nb->gR;
+        size_t n = nb->gn;
+        long hits = 0;
+        double shrink = 1.0 - GP_CONTACT_RTOL;
+        for (size_t k = 0; k < n; k++) {
+            double dx = gx[k] - x, dy = gy[k] - y, reach = (gR[k] + R) * shrink;
+            hits += dx * dx + dy * dy < reach * reach;
+        }
+        return hits == 0;
+    }
+    /* outside the box: the 3 x 3 cells around (x, y), as the grid scans them */
+    const gp_grid *g = &nb->grid;
+    int32_t cx, cy;
+    gp_grid_coords(g, x, y, &cx, &cy);
+    for (int32_t iy = cy - 1; iy <= cy + 1; iy++) {
+        if (iy < 0 || iy >= g->ny)
+            continue;
+        size_t first = gp_grid_index(g, cx > 0 ? cx - 1 : 0, iy);
+        size_t last = gp_grid_index(g, cx + 1 < g->nx ? cx + 1 : g->nx - 1, iy);
+        for (const nearby_entry *e = nb->sorted + nb->start[first]; e < nb->sorted + nb->start[last + 1]; e++)
+            if (e->id != id && overlaps(e->x - x, e->y - y, e->R, R))
+                return 0;
+        for (size_t c = first; c <= last; c++)
+            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->next[j])
+                if (j != id && overlaps(disks[j].x - x, disks[j].y - y, disks[j].R, R))
+                    return 0;
+    }
+    return 1;
+}
+
+void nearby_free(nearby *nb)
+{
+    gp_grid_free(&nb->grid);
+    free(nb->start);
+    free(nb->sorted);
+    free(nb->entry);
+    free(nb->gx);
+    free(nb->gy);
+    free(nb->gR);
+    memset(nb, 0, sizeof *nb);
+}
