@@ -418,6 +418,19 @@ static void test_nodes_hear_of_each_other_and_take_over_a_dead_nodes_jobs(void)
     gp_store_close(b);
 }
 
+static void test_a_location_is_logged_without_its_password(void)
+{
+    char out[256];
+    gp_store_redact("postgresql://alice:s3cret@db.example:5432/jobs?sslmode=require", out,
+                    sizeof out);
+    CHECK_STR(out, "postgresql://alice:***@db.example:5432/jobs?sslmode=require");
+    gp_store_redact("postgres://alice@db/jobs", out, sizeof out);
+    CHECK_STR(out, "postgres://alice@db/jobs");
+    gp_store_redact("/var/lib/grainpack/a:b@c.db", out, sizeof out); /* a file: as it is */
+    CHECK_STR(out, "/var/lib/grainpack/a:b@c.db");
+    CHECK(gp_store_location_is_pg("PostgreSQL://x") && !gp_store_location_is_pg("./pg.db"));
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || (strcmp(argv[1], "sqlite") != 0 && (strcmp(argv[1], "postgresql") != 0 || argc < 3))) {
@@ -440,6 +453,7 @@ int main(int argc, char **argv)
             return 1;
         }
     }
+    RUN(test_a_location_is_logged_without_its_password);
     RUN(test_jobs_are_claimed_oldest_first_and_results_read_back_whole);
     RUN(test_a_job_dismissed_while_it_runs_keeps_no_result);
     RUN(test_jobs_are_seen_by_their_owner_only);
