@@ -147,6 +147,12 @@ int main(int argc, char **argv)
         gp_log("cannot draw the page cursors' keys from the kernel's random source");
         goto done;
     }
+    /* nodes sharing a store share the keys: a page's next link works on any node */
+    if (shared && gp_store_secret(svc.store, "cursor keys", &svc.cursor_keys,
+                                  sizeof svc.cursor_keys)) {
+        gp_log("cannot read the page cursors' keys from the job store %s", where);
+        goto done;
+    }
     if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new(&svc.http)) ||
         gp_peers_watch(svc.peers, (double)cfg.connection_timeout) ||
         gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool) ||

@@ -180,6 +180,13 @@ const char *gp_store_node(gp_store *store)
     return ops_of(store)->node ? ops_of(store)->node(store) : "";
 }
 
+int gp_store_secret(gp_store *store, const char *name, void *out, size_t len)
+{
+    if (!ops_of(store)->secret)
+        return GP_SRV_ENOTFOUND;
+    return ops_of(store)->secret(store, name, out, len);
+}
+
 int gp_store_shared(gp_store *store)
 {
     return ops_of(store)->watch != NULL;

@@ -109,6 +109,11 @@ typedef struct gp_store_events {
     void (*waiting)(void *ctx, long accepted);   /* the jobs waiting, all nodes counted */
 } gp_store_events;
 
+/* The secret `name` of len bytes every node of a shared store uses (made by the first node
+ * that asks, from the kernel's random source). Returns 0 with out filled, GP_SRV_ENOTFOUND
+ * for a store that is not shared (the caller draws its own), or GP_SRV_EDB. */
+int gp_store_secret(gp_store *store, const char *name, void *out, size_t len);
+
 /* Whether several nodes may share the store: then one thread calls gp_store_watch again
  * and again while the daemon runs. */
 int gp_store_shared(gp_store *store);

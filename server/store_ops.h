@@ -63,6 +63,7 @@ struct gp_store_ops {
     int (*configure)(gp_store *store, const gp_store_options *options);
     int (*watch)(gp_store *store, const gp_store_events *events, double seconds);
     const char *(*node)(gp_store *store);
+    int (*secret)(gp_store *store, const char *name, void *out, size_t len);
 };
 
 extern const gp_store_ops gp_store_sqlite_ops;

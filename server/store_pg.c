@@ -389,6 +389,39 @@ static int pg_broken(const gp_db *db)
     return p->broken || PQstatus(p->conn) != CONNECTION_OK;
 }
 
+static int pg_secret(gp_store *s, const char *name, void *out, size_t len)
+{
+    gp_db *d = pg_acquire(s, 1);
+    if (!d)
+        return GP_SRV_EDB;
+    pg_db *db = gp_pg_db(d);
+    unsigned char *fresh = malloc(len);
+    if (!fresh) {
+        pg_release(s, d);
+        return GP_ENOMEM;
+    }
+    gp_store_random_bytes(fresh, len);
+    pg_params p = {0};
+    gp_pg_text(&p, name);
+    gp_pg_bytes(&p, fresh, len);
+    /* the first node's draw stays: the others read it */
+    int rc = gp_pg_run(db, "store a secret",
+                       "INSERT INTO grainpack_secrets (name, value) VALUES ($1, $2)"
+                       " ON CONFLICT (name) DO NOTHING",
+                       &p, NULL);
+    free(fresh);
+    PGresult *res = rc ? NULL : gp_pg_query(db, "read a secret",
+                                            "SELECT value FROM grainpack_secrets WHERE name = $1",
+                                            &(pg_params){.n = 1, .values = {name}}, 1, &rc);
+    if (res && PQntuples(res) == 1 && (size_t)PQgetlength(res, 0, 0) == len)
+        memcpy(out, PQgetvalue(res, 0, 0), len);
+    else if (res)
+        rc = GP_SRV_EDB; /* another size than asked: a secret of another build */
+    PQclear(res);
+    pg_release(s, d);
+    return rc;
+}
+
 const gp_store_ops gp_store_pg_ops = {
     .name = "postgresql",
     .close = pg_close,
@@ -415,4 +448,5 @@ const gp_store_ops gp_store_pg_ops = {
     .configure = pg_configure,
     .watch = gp_pg_watch,
     .node = pg_node,
+    .secret = pg_secret,
 };

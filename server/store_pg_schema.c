@@ -57,7 +57,10 @@ static const char schema_v3[] =
     "  section bigint NOT NULL REFERENCES result_sections (id) ON DELETE CASCADE,"
     "  chunk bigint NOT NULL, data bytea NOT NULL,"
     "  PRIMARY KEY (section, chunk));"
-    "ALTER TABLE result_chunks ALTER COLUMN data SET STORAGE EXTERNAL;";
+    "ALTER TABLE result_chunks ALTER COLUMN data SET STORAGE EXTERNAL;"
+    /* secrets every node must share: the keys of GET /jobs's page cursors (cursor.h), so
+     * that a listing's next page can be asked of any node */
+    "CREATE TABLE grainpack_secrets (name text PRIMARY KEY, value bytea NOT NULL);";
 
 /* version i's SQL at index i - 1; NULL: a version this store begins after */
 const char *const gp_pg_migrations[] = {NULL, NULL, schema_v3};

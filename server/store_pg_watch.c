@@ -65,12 +65,19 @@ static int renew(pg_store *store, pg_db *db, const gp_store_events *ev)
     pg_params p = {0};
     gp_pg_text(&p, store->run);
     gp_pg_double(&p, lease, store->lease_seconds);
-    int rc;
-    PGresult *res = gp_pg_query(db, "renew leases",
-                                "UPDATE jobs SET lease_until = now() + make_interval(secs =>"
-                                " $2::float8) WHERE node = $1 AND status = 'running'"
-                                " RETURNING id, claims",
-                                &p, 0, &rc);
+    /* SKIP LOCKED: a job whose row another transaction holds (this node storing its
+     * result, another dismissing it) is not waited for; it ends running soon */
+    int rc = gp_pg_run(db, "renew leases",
+                       "WITH mine AS (SELECT id FROM jobs WHERE node = $1 AND status = 'running'"
+                       " FOR UPDATE SKIP LOCKED) UPDATE jobs SET lease_until = now() +"
+                       " make_interval(secs => $2::float8) FROM mine WHERE jobs.id = mine.id",
+                       &p, NULL);
+    /* what the store says this run holds, as last committed (a plain read waits for no
+     * lock): a held job missing from it was dismissed, or taken after its lease expired */
+    PGresult *res = rc ? NULL : gp_pg_query(db, "read this node's jobs",
+                                            "SELECT id, claims FROM jobs WHERE node = $1"
+                                            " AND status = 'running'",
+                                            &(pg_params){.n = 1, .values = {store->run}}, 0, &rc);
     for (size_t i = 0; res && i < n; i++) {
         int found = 0;
         for (int row = 0; row < PQntuples(res) && !found; row++)

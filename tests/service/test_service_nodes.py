@@ -6,7 +6,8 @@ successful, its outcome stored exactly once (one "successful" in all the logs to
 the dead node's job run again by another after its lease, with its claim counted; every
 node answers for every job (status, results); a long-poll on one node wakes when another
 node finishes the job; a job of Alice's submitted to one node is 404 to Bob on another;
-the per-key limit counts a key's jobs on every node; a DELETE on one node stops the job
+the per-key limit counts a key's jobs on every node; a listing's next page made by one
+node is served by another; a DELETE on one node stops the job
 running on another within about a second (its lease renewal sees it); /health names the
 store and the node; no log shows the password.
 Usage: test_service_nodes.py GRAINPACKD PG_STATE (PGPASSWORD in the environment)"""
@@ -94,7 +95,9 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
         once = [job for job in ids if successes(nodes, job) != 1]
         c.check(not once, f"jobs whose outcome was not stored exactly once: {once[:5]}")
         claims = psql(uri, f"SELECT claims FROM jobs WHERE id = '{held}'")
-        c.check(claims == "2", f"the dead node's job was claimed twice: {claims}")
+        # twice: C's claim, then a live node's (more only if a loaded machine delayed a
+        # live node's renewals past its lease: then that node's result was refused)
+        c.check(claims.isdigit() and int(claims) >= 2, f"the dead node's job was claimed again: {claims}")
         c.check(f"job {held} successful" not in cc.log(), "the dead node did not finish it")
         counted = psql(uri, "SELECT count(*) FROM jobs WHERE status = 'successful'")
         c.check(counted == str(len(ids)), f"{counted} successful jobs of {len(ids)}")
@@ -105,6 +108,13 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
             n = int(status["message"].split()[0])
             c.check(r.status == 200 and r.body.count(b"\n") == n + 1,
                     f"job {job}: its CSV from node B has {n} disks: {r.status}")
+        # a listing's next page, made by A, asked of B (the nodes share the cursors' keys)
+        page = clients[0].get("/jobs?limit=5").json()
+        nxt = [link["href"] for link in page["links"] if link["rel"] == "next"]
+        second = clients[1].get(nxt[0]) if nxt else None
+        c.check(second is not None and second.status == 200 and
+                [j["jobID"] for j in second.json()["jobs"]][:1] == [ids[-6]],
+                f"A's next page on B: {second}")
         # a long-poll on A wakes when B finishes (submitted to B, which runs it)
         woke = False
         for attempt in range(12):
