@@ -289,7 +289,7 @@ def cancel(binary):
         rows.append((f"the same, left to its 5 s limit (failed {failed:.2f} s after it started)", failed + free,
                      time.monotonic() - t))
         metrics = urllib.request.urlopen(f"http://127.0.0.1:{port}/metrics").read().decode()
-        abandoned = [line for line in metrics.splitlines() if line.startswith('grainpack_job_runs_total{outcome="abandoned"}')]
+        abandoned = [line for line in metrics.splitlines() if line.startswith('grainpack_job_runs_total{outcome="abandoned",')]
         stop(proc, d)
         proc, port, d = start(binary, "--workers", "1", "--max-disks", "10000000")
         for stage in ("pack", "triangulation", "balance", "laguerre"):

@@ -18,7 +18,7 @@ pid=$!
 while [ ! -s "$dir/port" ]; do sleep 0.05; done
 base="http://127.0.0.1:$(cat "$dir/port")"
 health() { curl -sf "$base/health" | python3 -c "import json,sys; h=json.load(sys.stdin); print(h['$1'])"; }
-count() { curl -sf "$base/metrics" | awk -v k="grainpack_jobs{status=\"$1\"}" '$1 == k {print $2}'; }
+count() { curl -sf "$base/metrics" | awk -v k="grainpack_jobs{status=\"$1\"," 'index($1, k) == 1 {print $2}'; }
 
 # what else runs on the machine meanwhile (other builds make the latency tail longer):
 # the processes, not ours, that used more than a fifth of a core, sampled every second

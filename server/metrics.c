@@ -126,70 +126,93 @@ static void put_label_value(FILE *f, const char *value)
     }
 }
 
-char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
+/* The node's label (node="name"), escaped once, for every series: figures from several nodes
+ * stay apart in one query whatever the scraper adds; NULL when out of memory. */
+static char *node_label(const char *node)
 {
-    char *text = NULL;
-    FILE *f = open_memstream(&text, len);
+    char *label = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&label, &len);
     if (!f)
         return NULL;
-    /* the node's identity as an info metric: a node's figures are told apart by the
-     * scrape's own target label; this one adds the node's name and store to join on
-     * (group_left), as Prometheus' *_info convention has it, without a label more on
-     * every series */
+    fputs("node=\"", f);
+    put_label_value(f, node ? node : "");
+    fputc('"', f);
+    if (fclose(f) != 0) {
+        free(label);
+        return NULL;
+    }
+    return label;
+}
+
+char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
+{
+    char *nl = node_label(g->node);
+    if (!nl)
+        return NULL;
+    char *text = NULL;
+    FILE *f = open_memstream(&text, len);
+    if (!f) {
+        free(nl);
+        return NULL;
+    }
+    /* the node's identity as an info metric too (Prometheus' *_info convention), with the
+     * kind of store it talks to */
     fputs("# HELP grainpack_node_info This node: its name (--node) and its job store.\n"
           "# TYPE grainpack_node_info gauge\n", f);
-    fputs("grainpack_node_info{node=\"", f);
-    put_label_value(f, g->node ? g->node : "");
-    fprintf(f, "\",store=\"%s\"} 1\n", g->store ? g->store : "");
+    fprintf(f, "grainpack_node_info{%s,store=\"%s\"} 1\n", nl, g->store ? g->store : "");
     fputs("# HELP grainpack_http_requests_total HTTP requests answered, by status code.\n"
           "# TYPE grainpack_http_requests_total counter\n",
           f);
     for (unsigned code = 100; code < 600; code++) {
         unsigned long n = atomic_load(&m->requests[code]);
         if (n)
-            fprintf(f, "grainpack_http_requests_total{code=\"%u\"} %lu\n", code, n);
+            fprintf(f, "grainpack_http_requests_total{code=\"%u\",%s} %lu\n", code, nl, n);
     }
-    fputs("# HELP grainpack_jobs Jobs in the store, by status.\n# TYPE grainpack_jobs gauge\n", f);
+    fputs("# HELP grainpack_jobs Jobs in the store, by status (on a shared store, every "
+          "node's).\n# TYPE grainpack_jobs gauge\n", f);
     for (int s = 0; s < GP_JOB_NSTATUS; s++)
-        fprintf(f, "grainpack_jobs{status=\"%s\"} %ld\n", gp_job_status_name((gp_job_status)s),
-                g->jobs[s]);
+        fprintf(f, "grainpack_jobs{status=\"%s\",%s} %ld\n",
+                gp_job_status_name((gp_job_status)s), nl, g->jobs[s]);
     fprintf(f,
             "# HELP grainpack_queue_depth Accepted jobs waiting for a worker.\n"
-            "# TYPE grainpack_queue_depth gauge\ngrainpack_queue_depth %ld\n"
+            "# TYPE grainpack_queue_depth gauge\ngrainpack_queue_depth{%s} %ld\n"
             "# HELP grainpack_workers Worker threads.\n# TYPE grainpack_workers gauge\n"
-            "grainpack_workers %d\n"
+            "grainpack_workers{%s} %d\n"
             "# HELP grainpack_workers_busy Workers running a job.\n"
-            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy %d\n"
+            "# TYPE grainpack_workers_busy gauge\ngrainpack_workers_busy{%s} %d\n"
             "# HELP grainpack_workers_abandoned Worker threads given up on (told to stop, "
             "still running after seconds; another took each one's place).\n"
-            "# TYPE grainpack_workers_abandoned gauge\ngrainpack_workers_abandoned %d\n",
-            g->queue_depth, g->workers, g->workers_busy, g->workers_abandoned);
+            "# TYPE grainpack_workers_abandoned gauge\ngrainpack_workers_abandoned{%s} %d\n",
+            nl, g->queue_depth, nl, g->workers, nl, g->workers_busy, nl, g->workers_abandoned);
     fprintf(f,
             "# HELP grainpack_http_slow_heads_total Connections answered 408 and closed: their "
             "request head was not complete within --connection-timeout.\n"
-            "# TYPE grainpack_http_slow_heads_total counter\ngrainpack_http_slow_heads_total %lu\n"
+            "# TYPE grainpack_http_slow_heads_total counter\n"
+            "grainpack_http_slow_heads_total{%s} %lu\n"
             "# HELP grainpack_http_long_polls_hung_up_total Long-polls ended because their "
             "client closed the connection.\n"
             "# TYPE grainpack_http_long_polls_hung_up_total counter\n"
-            "grainpack_http_long_polls_hung_up_total %lu\n"
+            "grainpack_http_long_polls_hung_up_total{%s} %lu\n"
             "# HELP grainpack_http_connections HTTP connections open, waiting long-polls "
-            "included.\n# TYPE grainpack_http_connections gauge\ngrainpack_http_connections %ld\n",
-            g->slow_heads, g->polls_hung_up, g->connections);
+            "included.\n# TYPE grainpack_http_connections gauge\n"
+            "grainpack_http_connections{%s} %ld\n",
+            nl, g->slow_heads, nl, g->polls_hung_up, nl, g->connections);
     fputs("# HELP grainpack_job_runs_total Worker runs of a job, by how they ended.\n"
           "# TYPE grainpack_job_runs_total counter\n",
           f);
     for (size_t i = 0; i < NOUTCOMES; i++)
-        fprintf(f, "grainpack_job_runs_total{outcome=\"%s\"} %lu\n", outcome_names[i],
+        fprintf(f, "grainpack_job_runs_total{outcome=\"%s\",%s} %lu\n", outcome_names[i], nl,
                 atomic_load(&m->outcomes[i]));
     fprintf(f,
             "# HELP grainpack_pipeline_runs_total Runs of the job pipeline (packing and the "
             "stages after it) in this process: workers only; a download renders what is stored.\n"
-            "# TYPE grainpack_pipeline_runs_total counter\ngrainpack_pipeline_runs_total %lu\n"
+            "# TYPE grainpack_pipeline_runs_total counter\ngrainpack_pipeline_runs_total{%s} %lu\n"
             "# HELP grainpack_downloads Result downloads being streamed now.\n"
-            "# TYPE grainpack_downloads gauge\ngrainpack_downloads %ld\n"
+            "# TYPE grainpack_downloads gauge\ngrainpack_downloads{%s} %ld\n"
             "# HELP grainpack_downloads_total Result downloads started (304 answers not counted).\n"
-            "# TYPE grainpack_downloads_total counter\ngrainpack_downloads_total %lu\n",
-            atomic_load(&m->pipeline_runs), atomic_load(&m->downloads),
+            "# TYPE grainpack_downloads_total counter\ngrainpack_downloads_total{%s} %lu\n",
+            nl, atomic_load(&m->pipeline_runs), nl, atomic_load(&m->downloads), nl,
             atomic_load(&m->downloads_total));
     fputs("# HELP grainpack_stage_duration_seconds Wall-clock time of pipeline stages.\n"
           "# TYPE grainpack_stage_duration_seconds histogram\n",
@@ -202,16 +225,19 @@ char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
         unsigned long cumulative = 0;
         for (size_t b = 0; b < NBUCKETS; b++) {
             cumulative += atomic_load(&h->buckets[b]);
-            fprintf(f, "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"%g\"} %lu\n",
-                    name, bucket_bounds[b], cumulative);
+            fprintf(f,
+                    "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"%g\",%s} %lu\n",
+                    name, bucket_bounds[b], nl, cumulative);
         }
         unsigned long count = atomic_load(&h->count);
         fprintf(f,
-                "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"+Inf\"} %lu\n"
-                "grainpack_stage_duration_seconds_sum{stage=\"%s\"} %.6f\n"
-                "grainpack_stage_duration_seconds_count{stage=\"%s\"} %lu\n",
-                name, count, name, (double)atomic_load(&h->sum_us) * 1e-6, name, count);
+                "grainpack_stage_duration_seconds_bucket{stage=\"%s\",le=\"+Inf\",%s} %lu\n"
+                "grainpack_stage_duration_seconds_sum{stage=\"%s\",%s} %.6f\n"
+                "grainpack_stage_duration_seconds_count{stage=\"%s\",%s} %lu\n",
+                name, nl, count, name, nl, (double)atomic_load(&h->sum_us) * 1e-6, name, nl,
+                count);
     }
+    free(nl);
     if (fclose(f) != 0) {
         free(text);
         return NULL;

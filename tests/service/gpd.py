@@ -484,11 +484,14 @@ def find_overlaps(disks, limit=10):
 
 
 def metric(text, name, labels=""):
-    """The value of a Prometheus sample, or None."""
-    key = f"{name}{{{labels}}}" if labels else name
+    """The value of the Prometheus sample named `name` whose labels include every one of
+    `labels` (as written in the text format: 'status="successful"'), or None. Every series
+    carries its node's label too, so the labels asked for are a subset, in any order."""
+    wanted = set(re.findall(r'\w+="(?:[^"\\]|\\.)*"', labels))
     for line in text.splitlines():
-        if line.startswith(key + " "):
-            return float(line.split()[-1])
+        m = re.match(r'([a-zA-Z_:][\w:]*)(?:\{(.*)\})? (\S+)$', line)
+        if m and m.group(1) == name and wanted <= set(re.findall(r'\w+="(?:[^"\\]|\\.)*"', m.group(2) or "")):
+            return float(m.group(3))
     return None
 
 

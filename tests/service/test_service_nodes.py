@@ -70,6 +70,15 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
             h = n.client().get("/health").json()
             c.check(h.get("store") == "postgresql" and h.get("node") == name,
                     f"/health names the store and the node: {h}")
+            # every series of /metrics carries the node's label: three nodes' figures stay
+            # apart in one query
+            text = n.client(key=keys["ops"]).get("/metrics").body.decode()
+            series = [line for line in text.splitlines() if line and not line.startswith("#")]
+            c.check(series and all(f'node="{name}"' in line for line in series),
+                    f"{name}: a series of /metrics without its node label")
+            c.check(gpd.metric(text, "grainpack_workers", f'node="{name}"') == (1 if name == "node-c" else 2)
+                    and gpd.metric(text, "grainpack_node_info", f'node="{name}",store="postgresql"') == 1,
+                    f"{name}: the node's workers and info series")
         clients = [n.client(key=keys["batch"]) for n in nodes]
         ids = []
         for i in range(JOBS):
@@ -188,7 +197,8 @@ def test(c, binary, state):
     name, uri = new_database(admin)
     tmp = gpd.tempfile.mkdtemp(prefix="grainpackd-nodes-")
     key_file = os.path.join(tmp, "keys")
-    keys = gpd.write_keys(key_file, {"batch": "user", "alice": "user", "bob": "user"})
+    keys = gpd.write_keys(key_file, {"batch": "user", "alice": "user", "bob": "user",
+                                     "ops": "admin"})
     try:
         test_batch_and_kill(c, binary, uri, keys, key_file, tmp)
         test_keys_limits_and_dismissal(c, binary, uri, keys, key_file)
