@@ -289,6 +289,8 @@ int gp_mesh_build(const gp_mesh_input *in, const gp_mesh_params *params,
     gp_cdt_params cp = {
         .size_bound = params->element_size,
         .shape_bound = sine * sine,
+        .graded_region = geo.kind == GP_MESH_GRAINS_AND_BAND && params->grading ? (int32_t)geo.ngrains : -1,
+        .graded_size = params->band_size,
         .max_triangles = in->max_elements,
         .expected_triangles = expected_triangles(&geo, in->domain, params->element_size),
         .progress = progress,
