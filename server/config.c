@@ -27,6 +27,10 @@
  * (a crash, a kill, a stop it did not answer) is failed instead of claimed at every
  * start. Three lets a job survive two unrelated crashes or kills of the node. */
 #define DEFAULT_MAX_JOB_ATTEMPTS 3
+/* A node renews its leases every second (and at most a third of this): ten seconds rides
+ * out a stall of several renewals (a busy database, a paused virtual machine) and still
+ * hands a dead node's jobs to another within seconds. */
+#define DEFAULT_LEASE_SECONDS 10.0
 /* Enough for a script that submits a parameter sweep, far below the queue's size, so
  * that one user cannot fill the queue for everyone. */
 #define DEFAULT_MAX_JOBS_PER_KEY ((size_t)100)
@@ -62,7 +66,16 @@ static const option options[] = {
     {"--port", "GRAINPACKD_PORT", "port (default 8080; 0 picks a free one)", INT(port, 0, 65535)},
     {"--data-dir", "GRAINPACKD_DATA_DIR", "directory of the database (default ./data)",
      TEXT(data_dir)},
-    {"--db", "GRAINPACKD_DB", "database file (default DATA_DIR/grainpack.db)", TEXT(db_path)},
+    {"--db", "GRAINPACKD_DB",
+     "database: a sqlite file (default DATA_DIR/grainpack.db) or a postgresql:// URI, which "
+     "nodes share (password from PGPASSWORD or ~/.pgpass)",
+     TEXT(db_path)},
+    {"--node", "GRAINPACKD_NODE", "this node's name in a shared store (default: the host name)",
+     TEXT(node)},
+    {"--lease-seconds", "GRAINPACKD_LEASE_SECONDS",
+     "a shared store: seconds a running job's claim lasts unless its node renews it; a dead "
+     "node's jobs run again elsewhere after it (default 10)",
+     SECONDS(lease_seconds, 1, 3600)},
     {"--workers", "GRAINPACKD_WORKERS", "worker threads running jobs (default: cores)",
      INT(workers, 1, 256)},
     {"--http-threads", "GRAINPACKD_HTTP_THREADS", "HTTP threads (default: cores)",
@@ -117,7 +130,7 @@ static const option options[] = {
 static void usage(FILE *out)
 {
     fputs("Usage: grainpackd [OPTION VALUE]...\n"
-          "The grainpack job service: OGC API - Processes over HTTP, jobs in sqlite.\n\n",
+          "The grainpack job service: OGC API - Processes over HTTP, jobs in sqlite or PostgreSQL.\n\n",
           out);
     for (size_t i = 0; i < NOPTIONS; i++)
         fprintf(out, "  %-25s %s%s%s\n", options[i].flag, options[i].help,
@@ -194,6 +207,7 @@ int gp_config_load(gp_config *cfg, int argc, char **argv, FILE *out, FILE *err)
     cfg->max_elements = DEFAULT_MAX_ELEMENTS;
     cfg->max_job_seconds = DEFAULT_MAX_JOB_SECONDS;
     cfg->max_job_attempts = DEFAULT_MAX_JOB_ATTEMPTS;
+    cfg->lease_seconds = DEFAULT_LEASE_SECONDS;
     cfg->max_jobs_per_key = DEFAULT_MAX_JOBS_PER_KEY;
     cfg->max_wait = DEFAULT_MAX_WAIT;
     cfg->max_header_bytes = DEFAULT_MAX_HEADER_BYTES;
@@ -242,6 +256,9 @@ int gp_config_load(gp_config *cfg, int argc, char **argv, FILE *out, FILE *err)
             return -1;
         }
     }
+    if (!cfg->node[0] && (gethostname(cfg->node, sizeof cfg->node) != 0 || !cfg->node[0]))
+        snprintf(cfg->node, sizeof cfg->node, "grainpackd");
+    cfg->node[sizeof cfg->node - 1] = '\0'; /* gethostname does not say when it truncated */
     if (!cfg->key_file[0] && !cfg->insecure_open && !gp_config_is_loopback(cfg->host)) {
         fprintf(err,
                 "grainpackd: refusing to listen on %s without a key file: anyone who reaches "

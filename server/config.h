@@ -11,7 +11,11 @@ typedef struct gp_config {
     char host[64];            /* --host / GRAINPACKD_HOST, default 127.0.0.1 */
     int port;                 /* --port / GRAINPACKD_PORT, default 8080; 0 picks a free port */
     char data_dir[PATH_MAX];  /* --data-dir / GRAINPACKD_DATA_DIR, default ./data */
-    char db_path[PATH_MAX];   /* --db / GRAINPACKD_DB, default DATA_DIR/grainpack.db */
+    char db_path[PATH_MAX];   /* --db / GRAINPACKD_DB: a sqlite file, default
+                                 DATA_DIR/grainpack.db, or a postgresql:// URI */
+    char node[64];            /* --node / GRAINPACKD_NODE: the node's name, default the host name */
+    double lease_seconds;     /* --lease-seconds / GRAINPACKD_LEASE_SECONDS a shared store's
+                                 claim lasts unrenewed, default 10 */
     int workers;              /* --workers / GRAINPACKD_WORKERS, default: number of cores */
     int http_threads;         /* --http-threads / GRAINPACKD_HTTP_THREADS, default: cores */
     size_t max_body;          /* --max-body / GRAINPACKD_MAX_BODY bytes, default 1 MiB */

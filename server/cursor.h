@@ -5,7 +5,9 @@
  *
  * A token is one AES-128 block, in hex: the job's sequence number (8 bytes) and the
  * first 8 bytes of an HMAC-SHA256 of the viewer and that number, under two keys drawn at
- * start-up. A cursor is valid until the daemon stops. */
+ * start-up. A cursor is valid until the daemon stops; the nodes of a PostgreSQL store
+ * share their keys (kept in the database, gp_store_secret), so any node takes a cursor
+ * any other made, for as long as the database lives. */
 #ifndef GRAINPACKD_CURSOR_H
 #define GRAINPACKD_CURSOR_H
 

@@ -16,6 +16,7 @@
 #include "grainpack/version.h"
 #include "http.h"
 #include "log.h"
+#include "nodes.h"
 #include "peers.h"
 #include "service.h"
 #include "workers.h"
@@ -104,6 +105,7 @@ int main(int argc, char **argv)
     atomic_init(&svc.http.open, 0);
     atomic_init(&svc.http.slow_heads, 0);
     struct MHD_Daemon *http = NULL;
+    gp_nodes *nodes = NULL;
     int status = 1, requeued = 0, given_up = 0, lock_fd = -1;
     char why[512];
     if (cfg.key_file[0]) {
@@ -116,10 +118,16 @@ int main(int argc, char **argv)
         gp_log("no key file: the service is open to anyone who reaches %s (--key-file to "
                "require API keys)", cfg.host);
     }
-    if (make_db_dir(cfg.db_path) || (lock_fd = lock_database(cfg.db_path)) < 0)
+    /* a sqlite file is one node's (locked); a PostgreSQL database is shared by nodes */
+    int shared = gp_store_location_is_pg(cfg.db_path);
+    char where[PATH_MAX];
+    gp_store_redact(cfg.db_path, where, sizeof where);
+    if (!shared && (make_db_dir(cfg.db_path) || (lock_fd = lock_database(cfg.db_path)) < 0))
         goto done;
-    if (gp_store_open(cfg.db_path, &svc.store, why, sizeof why)) {
-        gp_log("cannot open the job store: %s", why);
+    gp_store_options store_options = {cfg.node, cfg.lease_seconds, cfg.max_job_attempts};
+    if (gp_store_open(cfg.db_path, &svc.store, why, sizeof why) ||
+        gp_store_configure(svc.store, &store_options)) {
+        gp_log("cannot open the job store %s: %s", where, why);
         goto done;
     }
     gp_db *db = gp_store_acquire(svc.store, 1);
@@ -127,7 +135,7 @@ int main(int argc, char **argv)
     if (!db || gp_store_recover(db, cfg.max_job_attempts, &requeued, &given_up) ||
         gp_store_count(db, counts)) {
         gp_store_release(svc.store, db);
-        gp_log("cannot read the job store %s", cfg.db_path);
+        gp_log("cannot read the job store %s", where);
         goto done;
     }
     gp_store_release(svc.store, db);
@@ -139,19 +147,26 @@ int main(int argc, char **argv)
         gp_log("cannot draw the page cursors' keys from the kernel's random source");
         goto done;
     }
+    /* nodes sharing a store share the keys: a page's next link works on any node */
+    if (shared && gp_store_secret(svc.store, "cursor keys", &svc.cursor_keys,
+                                  sizeof svc.cursor_keys)) {
+        gp_log("cannot read the page cursors' keys from the job store %s", where);
+        goto done;
+    }
     if (!(svc.metrics = gp_metrics_new()) || !(svc.peers = gp_peers_new(&svc.http)) ||
         gp_peers_watch(svc.peers, (double)cfg.connection_timeout) ||
-        gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool)) {
+        gp_waiters_start(&svc.waiters, &gp_http_suspender) || gp_pool_start(&svc, &svc.pool) ||
+        gp_nodes_start(&svc, &nodes)) {
         gp_log("out of memory starting up");
         goto done;
     }
     unsigned port;
     if (gp_http_start(&svc, &http, &port))
         goto done;
-    gp_log("grainpackd %s (pid %ld) listening on %s port %u; store %s (%ld jobs waiting, %d "
-           "of them queued again after a stop); %d workers",
-           GP_VERSION, (long)getpid(), cfg.host, port, cfg.db_path, counts[GP_JOB_ACCEPTED],
-           requeued, cfg.workers);
+    gp_log("grainpackd %s (pid %ld) listening on %s port %u; store %s %s (%ld jobs waiting, %d "
+           "of them queued again after a stop); %d workers; node %s",
+           GP_VERSION, (long)getpid(), cfg.host, port, gp_store_kind(svc.store), where,
+           counts[GP_JOB_ACCEPTED], requeued, cfg.workers, cfg.node);
     if (cfg.ready_file[0] && write_ready_file(cfg.ready_file, port))
         goto done;
 
@@ -181,6 +196,8 @@ done:
         gp_http_quiesce(http);
     double stop_began = gp_monotonic_seconds();
     int stuck = gp_pool_stop(svc.pool, STOP_WORKERS_SECONDS);
+    if (!stuck) /* the leases were renewed until the workers gave their jobs back */
+        gp_nodes_stop(nodes);
     gp_waiters_stop(svc.waiters);
     if (http)
         gp_http_stop(http);

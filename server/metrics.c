@@ -113,12 +113,34 @@ void gp_metrics_stage(gp_metrics *m, const char *stage, double seconds)
     atomic_fetch_add(&h->sum_us, (unsigned long long)(seconds * 1e6 + 0.5));
 }
 
+/* Writes a label value with the escapes of the text format (backslash, quote, newline). */
+static void put_label_value(FILE *f, const char *value)
+{
+    for (const char *c = value; *c; c++) {
+        if (*c == '\\' || *c == '"')
+            fputc('\\', f);
+        if (*c == '\n')
+            fputs("\\n", f);
+        else
+            fputc(*c, f);
+    }
+}
+
 char *gp_metrics_render(gp_metrics *m, const gp_metrics_gauges *g, size_t *len)
 {
     char *text = NULL;
     FILE *f = open_memstream(&text, len);
     if (!f)
         return NULL;
+    /* the node's identity as an info metric: a node's figures are told apart by the
+     * scrape's own target label; this one adds the node's name and store to join on
+     * (group_left), as Prometheus' *_info convention has it, without a label more on
+     * every series */
+    fputs("# HELP grainpack_node_info This node: its name (--node) and its job store.\n"
+          "# TYPE grainpack_node_info gauge\n", f);
+    fputs("grainpack_node_info{node=\"", f);
+    put_label_value(f, g->node ? g->node : "");
+    fprintf(f, "\",store=\"%s\"} 1\n", g->store ? g->store : "");
     fputs("# HELP grainpack_http_requests_total HTTP requests answered, by status code.\n"
           "# TYPE grainpack_http_requests_total counter\n",
           f);

@@ -42,6 +42,7 @@ typedef struct gp_metrics_gauges {
     unsigned long slow_heads;     /* connections closed for a late request head */
     long connections;             /* HTTP connections open */
     unsigned long polls_hung_up;  /* long-polls ended by their client's hang-up */
+    const char *node, *store;     /* the node's name and its store's kind (the info metric) */
 } gp_metrics_gauges;
 
 /* The whole exposition as a malloc'd text (caller frees), NULL when out of memory. */

@@ -99,12 +99,13 @@ int gp_route_health(gp_request *req, gp_reply *reply)
                                                         : "ok";
     const char *status = !db_ok ? "unavailable" : writes ? "degraded" : "ok";
     int accepting = atomic_load(&svc->accepting);
-    json_t *body = json_pack("{s:s, s:s, s:b, s:s, s:i, s:i, s:I, s:f, s:s}", "status", status,
-                             "database", database, "accepting", accepting, "access",
+    json_t *body = json_pack("{s:s, s:s, s:b, s:s, s:i, s:i, s:I, s:f, s:s, s:s, s:s}", "status",
+                             status, "database", database, "accepting", accepting, "access",
                              svc->keys ? "keys" : "open", "workers", svc->cfg->workers,
                              "workers_busy", gp_pool_busy(svc->pool), "queue_depth",
                              (json_int_t)atomic_load(&svc->queued), "uptime_seconds",
-                             gp_monotonic_seconds() - svc->started, "version", GP_VERSION);
+                             gp_monotonic_seconds() - svc->started, "version", GP_VERSION,
+                             "store", gp_store_kind(svc->store), "node", svc->cfg->node);
     gp_reply_json(reply, db_ok ? 200 : 503, JSON_TYPE, body);
     if (!db_ok)
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
@@ -130,6 +131,8 @@ int gp_route_metrics(gp_request *req, gp_reply *reply)
     g.slow_heads = atomic_load(&svc->http.slow_heads);
     g.connections = atomic_load(&svc->http.open);
     g.polls_hung_up = gp_waiters_hung_up(svc->waiters);
+    g.node = svc->cfg->node;
+    g.store = gp_store_kind(svc->store);
     size_t len;
     char *text = gp_metrics_render(svc->metrics, &g, &len);
     if (!text) {

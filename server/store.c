@@ -1,144 +1,24 @@
-/* store.c - the sqlite3 job store: connections (a pool, one per thread at a time),
- * migrations, the statements every query uses (prepared once per connection), and the
- * transaction helpers of store_db.h. The queries are in store_jobs.c and store_results.c. */
-#include "store_db.h"
+/* store.c - the job store's calls (store.h), passed on to the backend the store was
+ * opened with (store_ops.h), and what both backends share: status names, error texts,
+ * job ids and result versions. */
+#include "store_ops.h"
 
-#include <errno.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/random.h>
 
 #include "log.h"
-#include "store_schema.h"
 
-/* How long a writer waits for another connection's transaction before giving up. Writes
- * are short (one job row, or one result), so this is only reached when the disk stalls. */
-#define BUSY_TIMEOUT_MS 30000
-
-/* Bytes the WAL file is cut back to after a checkpoint (see PRAGMA journal_size_limit). */
-#define WAL_SIZE_LIMIT (64 << 20)
-
-/* has_mesh: the spec asks for a mesh ("mesh" in the inputs, wrapped or bare: a bare spec
- * cannot hold "inputs"), so that a job lists the mesh formats only when it has them */
-#define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message," \
-                    " coalesce(json_type(spec, '$.inputs.mesh'), json_type(spec, '$.mesh')) IS NOT NULL"
-
-static const char *const stmt_sql[ST_COUNT_OF] = {
-    [ST_INSERT] = "INSERT INTO jobs (id, status, created, updated, message, spec, domain_width,"
-                  " domain_height, distribution, joint, level_band, seed, expected_disks, owner)"
-                  " VALUES (?1, 'accepted', ?2, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)"
-                  " RETURNING seq",
-    /* an owner of NULL sees every job */
-    [ST_GET] = "SELECT " JOB_COLUMNS " FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
-    /* status_mask bit i selects status i, in gp_job_status order */
-    [ST_LIST] = "SELECT " JOB_COLUMNS " FROM jobs WHERE seq < ?1 AND (?2 = 0 OR"
-                " (?2 >> (CASE status WHEN 'accepted' THEN 0 WHEN 'running' THEN 1"
-                " WHEN 'successful' THEN 2 WHEN 'failed' THEN 3 ELSE 4 END)) & 1)"
-                " AND (?4 IS NULL OR owner = ?4)"
-                " ORDER BY seq DESC LIMIT ?3",
-    [ST_CLAIM] = "UPDATE jobs SET status = 'running', started = ?1, updated = ?1, progress = 0,"
-                 " message = 'running', claims = claims + 1"
-                 " WHERE seq = (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1)"
-                 " RETURNING id, spec",
-    [ST_PROGRESS] = "UPDATE jobs SET progress = ?2, message = ?3, updated = ?4"
-                    " WHERE id = ?1 AND status = 'running'",
-    [ST_FINISH] = "UPDATE jobs SET status = 'successful', progress = 100, message = ?2,"
-                  " finished = ?3, updated = ?3, count = ?4, packing_density = ?5,"
-                  " grain_fraction = ?6, r_min = ?7, r_max = ?8, r_mean = ?9, chi2 = ?10,"
-                  " dof = ?11, p_value = ?12, max_abs_z = ?13, initial_disks = ?14,"
-                  " front_attempts = ?15, front_closures = ?16, front_frozen = ?17,"
-                  " front_capped = ?18, max_level = ?19, result_version = ?20"
-                  " WHERE id = ?1 AND status = 'running'",
-    [ST_SECTION] = "INSERT INTO result_sections (job_id, tag, version, bytes, summary)"
-                   " VALUES (?1, ?2, ?3, ?4, ?5) RETURNING id",
-    [ST_CHUNK] = "INSERT INTO result_chunks (section, chunk, data) VALUES (?1, ?2, ?3)",
-    [ST_BIN] = "INSERT OR REPLACE INTO bin_stats (job_id, bin, min, max, target, achieved, count, z)"
-               " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
-    [ST_TIMING] = "INSERT OR REPLACE INTO stage_timings (job_id, position, stage, seconds)"
-                  " VALUES (?1, ?2, ?3, ?4)",
-    [ST_FAIL] = "UPDATE jobs SET status = 'failed', error = ?2, message = ?3, finished = ?4,"
-                " updated = ?4 WHERE id = ?1 AND status = 'running'",
-    /* a stop that cancelled the job cleanly: its claim does not count (--max-job-attempts
-     * counts the runs the daemon died in) */
-    [ST_REQUEUE] = "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
-                   " message = ?2, updated = ?3, claims = max(claims - 1, 0)"
-                   " WHERE id = ?1 AND status = 'running'",
-    [ST_STATUS] = "SELECT status FROM jobs WHERE id = ?1 AND (?2 IS NULL OR owner = ?2)",
-    [ST_DISMISS] = "UPDATE jobs SET status = 'dismissed', message = ?2, finished = ?3, updated = ?3"
-                   " WHERE id = ?1 AND status IN ('accepted', 'running')",
-    [ST_DELETE] = "DELETE FROM jobs WHERE id = ?1",
-    [ST_OPEN_RESULT] = "SELECT seq, spec, result_version FROM jobs"
-                       " WHERE id = ?1 AND status = 'successful' AND (?2 IS NULL OR owner = ?2)",
-    [ST_SUMMARY_SECTIONS] = "SELECT tag, version, id, bytes FROM result_sections"
-                            " WHERE job_id = ?1 AND summary = 1 ORDER BY id",
-    [ST_FIND_SECTION] = "SELECT s.id, s.bytes FROM result_sections s JOIN jobs j ON j.id = s.job_id"
-                        " WHERE j.seq = ?1 AND s.tag = ?2",
-    [ST_READ_CHUNK] = "SELECT data FROM result_chunks WHERE section = ?1 AND chunk = ?2",
-    [ST_TIMINGS] = "SELECT stage, seconds FROM stage_timings WHERE job_id = ?1 ORDER BY position",
-    [ST_COUNT] = "SELECT status, count(*) FROM jobs GROUP BY status",
-    [ST_ACTIVE] = "SELECT count(*) FROM jobs WHERE owner = ?1 AND status IN ('accepted', 'running')",
-};
-
-struct gp_store {
-    char *path;
-    pthread_mutex_t lock; /* guards free_list and all only */
-    gp_db *free_list[2];  /* idle connections, by durability */
-    gp_db **all;          /* every connection open, closed by gp_store_close */
-    size_t nall, capall;
-    atomic_int write_state; /* 0, GP_SRV_EFULL or GP_SRV_EUNWRITABLE: the last write's fate */
-    /* Moves on when writes start failing and when they work again. A connection opened in
-     * another generation is not reused: one opened while the files could not be written
-     * may stay read-only for good (sqlite opens the WAL read-only and says nothing), and
-     * one opened before may hold what the failure left behind. */
-    atomic_int generation;
-};
-
-/* Records how a write went: a change from working to failing or back starts a new
- * generation of connections. */
-static void set_write_state(gp_store *store, int state)
+static const gp_store_ops *ops_of(gp_store *store)
 {
-    if (!store)
-        return;
-    int before = atomic_exchange(&store->write_state, state);
-    if ((before == 0) != (state == 0))
-        atomic_fetch_add(&store->generation, 1);
+    return ((const gp_store_head *)(const void *)store)->ops;
 }
 
-/* What the last failure of db's connection means for the caller: no space (sqlite maps
- * ENOSPC to SQLITE_FULL; a quota or the file size limit come as write errors with their
- * errno, when sqlite still has it), files that refuse writes (read-only, immutable, or
- * failing: sqlite's errno is not reliable enough to tell these apart), or anything else. */
-static int classify(gp_db *db)
+static const gp_store_ops *db_ops(const gp_db *db)
 {
-    int ext = sqlite3_extended_errcode(db->conn), primary = ext & 0xff;
-    int sys = sqlite3_system_errno(db->conn);
-    if (primary == SQLITE_FULL || (primary == SQLITE_IOERR && (sys == ENOSPC || sys == EDQUOT ||
-                                                                sys == EFBIG)))
-        return GP_SRV_EFULL;
-    if (primary == SQLITE_READONLY || ext == SQLITE_IOERR_WRITE || ext == SQLITE_IOERR_FSYNC ||
-        ext == SQLITE_IOERR_DIR_FSYNC || ext == SQLITE_IOERR_TRUNCATE ||
-        ext == SQLITE_IOERR_SHMSIZE || ext == SQLITE_IOERR_SHMOPEN)
-        return GP_SRV_EUNWRITABLE;
-    return GP_SRV_EDB;
-}
-
-/* Logs a failure and returns its class (see classify). A connection that met an I/O or
- * permission error is not trusted again: it is closed when released. */
-int gp_db_fail(gp_db *db, const char *what)
-{
-    int primary = sqlite3_extended_errcode(db->conn) & 0xff;
-    int sys = sqlite3_system_errno(db->conn);
-    int rc = classify(db);
-    gp_log("store: %s: %s%s%s", what, sqlite3_errmsg(db->conn), sys ? ": " : "",
-           sys ? strerror(sys) : "");
-    if (primary == SQLITE_IOERR || primary == SQLITE_READONLY || primary == SQLITE_CORRUPT ||
-        primary == SQLITE_CANTOPEN)
-        db->broken = 1;
-    if (rc != GP_SRV_EDB)
-        set_write_state(db->store, rc);
-    return rc;
+    return ops_of(((const gp_db_head *)(const void *)db)->store);
 }
 
 const char *gp_srv_strerror(int code)
@@ -154,343 +34,266 @@ const char *gp_srv_strerror(int code)
     }
 }
 
-static void db_close(gp_db *db)
+static const char *const status_names[GP_JOB_NSTATUS] = {"accepted", "running", "successful",
+                                                          "failed", "dismissed"};
+
+const char *gp_job_status_name(gp_job_status status)
 {
-    if (!db)
-        return;
-    for (int i = 0; i < ST_COUNT_OF; i++)
-        sqlite3_finalize(db->stmt[i]);
-    sqlite3_finalize(db->begin);
-    sqlite3_finalize(db->commit);
-    sqlite3_finalize(db->rollback);
-    sqlite3_close(db->conn);
-    free(db);
+    return status < GP_JOB_NSTATUS ? status_names[status] : "unknown";
 }
 
-/* Opens a connection with the pragmas every connection needs. */
-static gp_db *db_open(const char *path, int durable, char *why, size_t why_size)
+int gp_job_status_parse(const char *name, gp_job_status *out)
 {
-    gp_db *db = calloc(1, sizeof *db);
-    if (!db) {
-        snprintf(why, why_size, "out of memory");
-        return NULL;
+    for (int i = 0; i < GP_JOB_NSTATUS; i++) {
+        if (strcmp(name, status_names[i]) == 0) {
+            *out = (gp_job_status)i;
+            return 0;
+        }
     }
-    db->durable = durable;
-    int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX;
-    if (sqlite3_open_v2(path, &db->conn, flags, NULL) != SQLITE_OK) {
-        snprintf(why, why_size, "cannot open %s: %s", path,
-                 db->conn ? sqlite3_errmsg(db->conn) : "out of memory");
-        db_close(db);
-        return NULL;
+    return GP_EINVAL;
+}
+
+void gp_store_random_bytes(void *buf, size_t len)
+{
+    size_t got = 0;
+    while (got < len) {
+        ssize_t n = getrandom((unsigned char *)buf + got, len - got, 0);
+        if (n > 0)
+            got += (size_t)n;
     }
-    sqlite3_busy_timeout(db->conn, BUSY_TIMEOUT_MS);
-    /* journal_size_limit: a large result (tens of MB) grows the WAL; once checkpointed,
-     * the file is cut back instead of staying that large */
-    char pragmas[200];
-    snprintf(pragmas, sizeof pragmas,
-             "PRAGMA journal_mode = WAL; PRAGMA synchronous = %s; PRAGMA foreign_keys = ON;"
-             " PRAGMA journal_size_limit = %d;",
-             durable ? "FULL" : "NORMAL", WAL_SIZE_LIMIT);
-    char *msg = NULL;
-    if (sqlite3_exec(db->conn, pragmas, NULL, NULL, &msg) != SQLITE_OK ||
-        sqlite3_prepare_v3(db->conn, "BEGIN IMMEDIATE", -1, SQLITE_PREPARE_PERSISTENT, &db->begin,
-                           NULL) != SQLITE_OK ||
-        sqlite3_prepare_v3(db->conn, "COMMIT", -1, SQLITE_PREPARE_PERSISTENT, &db->commit, NULL) !=
-            SQLITE_OK ||
-        sqlite3_prepare_v3(db->conn, "ROLLBACK", -1, SQLITE_PREPARE_PERSISTENT, &db->rollback,
-                           NULL) != SQLITE_OK) {
-        snprintf(why, why_size, "cannot set up %s: %s", path, msg ? msg : sqlite3_errmsg(db->conn));
-        sqlite3_free(msg);
-        db_close(db);
-        return NULL;
+}
+
+void gp_store_new_job_id(char out[GP_JOB_ID_SIZE])
+{
+    unsigned char b[16];
+    gp_store_random_bytes(b, sizeof b);
+    b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
+    b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
+    snprintf(out, GP_JOB_ID_SIZE,
+             "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0], b[1],
+             b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14],
+             b[15]);
+}
+
+void gp_store_new_result_version(char out[33])
+{
+    unsigned char b[16];
+    gp_store_random_bytes(b, sizeof b);
+    for (size_t i = 0; i < sizeof b; i++)
+        snprintf(out + 2 * i, 3, "%02x", b[i]);
+}
+
+int gp_store_conns_add(gp_store_conns *c, void *db)
+{
+    if (c->n == c->cap) {
+        size_t cap = c->cap ? c->cap * 2 : 16;
+        void **grown = realloc(c->items, cap * sizeof *grown);
+        if (!grown)
+            return GP_ENOMEM;
+        c->items = grown;
+        c->cap = cap;
     }
-    return db;
+    c->items[c->n++] = db;
+    return 0;
 }
 
-sqlite3_stmt *gp_db_stmt(gp_db *db, enum stmt_id id)
+void gp_store_conns_remove(gp_store_conns *c, void *db)
 {
-    if (!db->stmt[id] && sqlite3_prepare_v3(db->conn, stmt_sql[id], -1, SQLITE_PREPARE_PERSISTENT,
-                                            &db->stmt[id], NULL) != SQLITE_OK) {
-        gp_db_fail(db, "prepare");
-        return NULL;
+    for (size_t i = 0; i < c->n; i++) {
+        if (c->items[i] == db) {
+            c->items[i] = c->items[--c->n];
+            return;
+        }
     }
-    sqlite3_reset(db->stmt[id]);
-    sqlite3_clear_bindings(db->stmt[id]);
-    return db->stmt[id];
 }
 
-/* Steps s once and resets it: 0 (a row or done) or GP_SRV_EDB. */
-static int step(sqlite3_stmt *s)
+void gp_store_new_job(gp_job *out, const gp_spec *spec)
 {
-    int rc = sqlite3_step(s);
-    sqlite3_reset(s);
-    return rc == SQLITE_DONE || rc == SQLITE_ROW ? 0 : GP_SRV_EDB;
+    memset(out, 0, sizeof *out);
+    gp_store_new_job_id(out->id);
+    gp_timestamp_now(out->created);
+    snprintf(out->updated, sizeof out->updated, "%s", out->created);
+    snprintf(out->message, sizeof out->message, "queued");
+    out->status = GP_JOB_ACCEPTED;
+    out->has_mesh = spec->mesh_enabled;
 }
 
-int gp_db_run(gp_db *db, sqlite3_stmt *s, const char *what)
+int gp_store_write_sections(const char *id, const gp_result *result,
+                            int (*write)(void *ctx, const char *id, const gp_section *sec),
+                            void *ctx)
 {
-    return step(s) ? gp_db_fail(db, what) : 0;
-}
-
-int gp_db_run_one(gp_db *db, sqlite3_stmt *s, const char *what)
-{
-    int rc = gp_db_run(db, s, what);
-    return rc == 0 && sqlite3_changes(db->conn) == 0 ? GP_SRV_ESTATE : rc;
-}
-
-/* ROLLBACK when a transaction is open. */
-static void rollback(gp_db *db)
-{
-    if (!sqlite3_get_autocommit(db->conn))
-        step(db->rollback);
-}
-
-sqlite3_stmt *gp_db_write(gp_db *db, enum stmt_id id, int *rc)
-{
-    sqlite3_stmt *s = gp_db_stmt(db, id);
-    if (!s) {
-        *rc = GP_SRV_EDB;
-        return NULL;
-    }
-    *rc = gp_db_run(db, db->begin, "begin immediate");
-    return *rc ? NULL : s;
-}
-
-int gp_db_end(gp_db *db, int rc)
-{
-    if (rc) {
-        rollback(db);
+    gp_section sections[GP_SECTIONS_MAX];
+    size_t n;
+    int rc = gp_sections_from_result(result, sections, &n);
+    if (rc)
         return rc;
-    }
-    if (step(db->commit) == 0) {
-        set_write_state(db->store, 0);
-        return 0;
-    }
-    rc = gp_db_fail(db, "commit");
-    step(db->rollback);
+    for (size_t i = 0; rc == 0 && i < n; i++)
+        rc = write(ctx, id, &sections[i]);
+    gp_sections_free(sections, n);
     return rc;
 }
 
-static int exec_sql(sqlite3 *conn, const char *sql, char *why, size_t why_size)
+int gp_store_location_is_pg(const char *location)
 {
-    char *msg = NULL;
-    if (sqlite3_exec(conn, sql, NULL, NULL, &msg) == SQLITE_OK)
-        return 0;
-    snprintf(why, why_size, "%s", msg ? msg : sqlite3_errmsg(conn));
-    sqlite3_free(msg);
-    return GP_SRV_EDB;
+    return strncasecmp(location, "postgresql://", 13) == 0 ||
+           strncasecmp(location, "postgres://", 11) == 0;
 }
 
-/* Brings the schema to GP_STORE_SCHEMA_VERSION, one migration per transaction. */
-static int migrate(gp_db *db, char *why, size_t why_size)
+void gp_store_redact(const char *location, char *out, size_t size)
 {
-    for (;;) {
-        if (exec_sql(db->conn, "BEGIN IMMEDIATE", why, why_size))
-            return GP_SRV_EDB;
-        sqlite3_stmt *s;
-        int version = -1;
-        if (sqlite3_prepare_v2(db->conn, "PRAGMA user_version", -1, &s, NULL) == SQLITE_OK) {
-            if (sqlite3_step(s) == SQLITE_ROW)
-                version = sqlite3_column_int(s, 0);
-            sqlite3_finalize(s);
-        }
-        if (version < 0 || (size_t)version > gp_store_migration_count) {
-            snprintf(why, why_size, "schema version %d is not one this build knows (0..%zu)",
-                     version, gp_store_migration_count);
-            char ignored[8];
-            exec_sql(db->conn, "ROLLBACK", ignored, sizeof ignored);
-            return GP_SRV_EDB;
-        }
-        if ((size_t)version == gp_store_migration_count)
-            return exec_sql(db->conn, "COMMIT", why, why_size);
-        char set_version[48];
-        snprintf(set_version, sizeof set_version, "PRAGMA user_version = %d", version + 1);
-        if (exec_sql(db->conn, gp_store_migrations[version], why, why_size) ||
-            (gp_store_conversions[version] && gp_store_conversions[version](db, why, why_size)) ||
-            exec_sql(db->conn, set_version, why, why_size) ||
-            exec_sql(db->conn, "COMMIT", why, why_size)) {
-            char ignored[8];
-            exec_sql(db->conn, "ROLLBACK", ignored, sizeof ignored);
-            return GP_SRV_EDB;
-        }
-        gp_log("store: schema migrated to version %d", version + 1);
+    /* scheme://user:password@host...: the password is what lies between the first ':'
+     * after the scheme and the '@' of the authority */
+    const char *auth = strstr(location, "://");
+    if (!gp_store_location_is_pg(location) || !auth) {
+        snprintf(out, size, "%s", location);
+        return;
     }
+    auth += 3;
+    size_t len = strcspn(auth, "/?");
+    const char *at = memchr(auth, '@', len), *colon = memchr(auth, ':', len);
+    if (!at || !colon || colon > at) {
+        snprintf(out, size, "%s", location);
+        return;
+    }
+    snprintf(out, size, "%.*s***%s", (int)(colon + 1 - location), location, at);
 }
 
-int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up)
+int gp_store_open(const char *location, gp_store **out, char *why, size_t why_size)
 {
-    /* a job still running in the store was running when the daemon died: its claims
-     * count the starts it did not survive (a clean stop gives its claim back) */
-    char now[GP_TIMESTAMP_SIZE], fail[512], requeue[320];
-    gp_timestamp_now(now);
-    snprintf(fail, sizeof fail,
-             "UPDATE jobs SET status = 'failed', error = 'gave up', finished = '%s',"
-             " updated = '%s', message = 'failed: the daemon stopped ' || claims ||"
-             " ' times while this job ran (a crash, a kill, or a stop it did not answer"
-             " in time); it is not run again (--max-job-attempts %d)'"
-             " WHERE status = 'running' AND claims >= %d",
-             now, now, max_attempts, max_attempts);
-    snprintf(requeue, sizeof requeue,
-             "UPDATE jobs SET status = 'accepted', started = NULL, progress = 0,"
-             " message = '" GP_REQUEUE_MESSAGE "', updated = '%s'"
-             " WHERE status = 'running'",
-             now);
-    int rc = gp_db_run(db, db->begin, "begin immediate");
-    if (rc)
-        return rc;
-    char *msg = NULL;
-    if (sqlite3_exec(db->conn, fail, NULL, NULL, &msg) != SQLITE_OK)
-        goto failed;
-    *given_up = sqlite3_changes(db->conn);
-    if (sqlite3_exec(db->conn, requeue, NULL, NULL, &msg) != SQLITE_OK)
-        goto failed;
-    *requeued = sqlite3_changes(db->conn);
-    return gp_db_end(db, 0);
-failed:
-    sqlite3_free(msg);
-    return gp_db_end(db, gp_db_fail(db, "recover running jobs"));
+    if (gp_store_location_is_pg(location))
+        return gp_store_pg_open(location, out, why, why_size);
+    return gp_store_sqlite_open(location, out, why, why_size);
 }
 
-/* Adds db to the list of connections closed with the store. */
-static int remember(gp_store *store, gp_db *db)
+const char *gp_store_kind(gp_store *store)
 {
-    if (store->nall == store->capall) {
-        size_t cap = store->capall ? store->capall * 2 : 16;
-        gp_db **grown = realloc(store->all, cap * sizeof *grown);
-        if (!grown)
-            return GP_ENOMEM;
-        store->all = grown;
-        store->capall = cap;
-    }
-    store->all[store->nall++] = db;
-    return 0;
+    return ops_of(store)->name;
 }
 
-int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size)
+int gp_store_configure(gp_store *store, const gp_store_options *options)
 {
-    *out = NULL;
-    gp_store *store = calloc(1, sizeof *store);
-    if (!store || !(store->path = strdup(path))) {
-        free(store);
-        snprintf(why, why_size, "out of memory");
-        return GP_ENOMEM;
-    }
-    pthread_mutex_init(&store->lock, NULL);
-    gp_db *db = db_open(path, 1, why, why_size);
-    if (db)
-        db->store = store;
-    int rc = db ? migrate(db, why, why_size) : GP_SRV_EDB;
-    if (rc == 0)
-        rc = remember(store, db);
-    if (rc) {
-        db_close(db);
-        gp_store_close(store);
-        return rc;
-    }
-    db->next_free = NULL;
-    store->free_list[1] = db;
-    *out = store;
-    return 0;
+    return ops_of(store)->configure ? ops_of(store)->configure(store, options) : 0;
+}
+
+const char *gp_store_node(gp_store *store)
+{
+    return ops_of(store)->node ? ops_of(store)->node(store) : "";
+}
+
+int gp_store_secret(gp_store *store, const char *name, void *out, size_t len)
+{
+    if (!ops_of(store)->secret)
+        return GP_SRV_ENOTFOUND;
+    return ops_of(store)->secret(store, name, out, len);
+}
+
+int gp_store_shared(gp_store *store)
+{
+    return ops_of(store)->watch != NULL;
+}
+
+int gp_store_watch(gp_store *store, const gp_store_events *events, double seconds)
+{
+    return ops_of(store)->watch ? ops_of(store)->watch(store, events, seconds) : 0;
 }
 
 void gp_store_close(gp_store *store)
 {
-    if (!store)
-        return;
-    for (size_t i = 0; i < store->nall; i++)
-        db_close(store->all[i]);
-    free(store->all);
-    pthread_mutex_destroy(&store->lock);
-    free(store->path);
-    free(store);
+    if (store)
+        ops_of(store)->close(store);
 }
 
 gp_db *gp_store_acquire(gp_store *store, int durable)
 {
-    durable = durable ? 1 : 0;
-    pthread_mutex_lock(&store->lock);
-    gp_db *db = store->free_list[durable];
-    if (db)
-        store->free_list[durable] = db->next_free;
-    pthread_mutex_unlock(&store->lock);
-    if (db && gp_store_broken(db)) { /* from another generation: a fresh one instead */
-        db->broken = 1;
-        gp_store_release(store, db);
-        db = NULL;
-    }
-    if (db)
-        return db;
-    char why[256];
-    db = db_open(store->path, durable, why, sizeof why);
-    if (!db) {
-        gp_log("store: %s", why);
-        return NULL;
-    }
-    db->store = store;
-    db->generation = atomic_load(&store->generation);
-    pthread_mutex_lock(&store->lock);
-    int rc = remember(store, db);
-    pthread_mutex_unlock(&store->lock);
-    if (rc) {
-        db_close(db);
-        return NULL;
-    }
-    return db;
+    return ops_of(store)->acquire(store, durable);
 }
 
 void gp_store_release(gp_store *store, gp_db *db)
 {
-    if (!db)
-        return;
-    rollback(db); /* a caller that bailed out mid-transaction must not hold the write lock */
-    if (gp_store_broken(db)) {
-        pthread_mutex_lock(&store->lock);
-        for (size_t i = 0; i < store->nall; i++) {
-            if (store->all[i] == db) {
-                store->all[i] = store->all[--store->nall];
-                break;
-            }
-        }
-        pthread_mutex_unlock(&store->lock);
-        db_close(db);
-        return;
-    }
-    pthread_mutex_lock(&store->lock);
-    db->next_free = store->free_list[db->durable];
-    store->free_list[db->durable] = db;
-    pthread_mutex_unlock(&store->lock);
+    if (db)
+        ops_of(store)->release(store, db);
 }
 
-void gp_db_copy_text(char *dst, size_t size, sqlite3_stmt *s, int col)
+int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up)
 {
-    const unsigned char *t = sqlite3_column_text(s, col);
-    snprintf(dst, size, "%s", t ? (const char *)t : "");
+    return db_ops(db)->recover(db, max_attempts, requeued, given_up);
 }
 
-void gp_db_bind_owner(sqlite3_stmt *s, int i, const char *owner)
+int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
+                        size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
 {
-    if (owner)
-        sqlite3_bind_text(s, i, owner, -1, SQLITE_STATIC);
-    else
-        sqlite3_bind_null(s, i);
+    return db_ops(db)->insert_job(db, owner, max_active, spec_text, spec_len, spec, out, active);
 }
 
-int gp_store_write_state(gp_store *store)
+int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
 {
-    return atomic_load(&store->write_state);
+    return db_ops(db)->get_job(db, id, owner, out);
 }
 
-int gp_store_broken(const gp_db *db)
+int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
+                       size_t limit, gp_job *out, size_t *n, int *more)
 {
-    return db && (db->broken || db->generation != atomic_load(&db->store->generation));
+    return db_ops(db)->list_jobs(db, owner, status_mask, before, limit, out, n, more);
+}
+
+int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+                   size_t *spec_len)
+{
+    return db_ops(db)->claim(db, queued, id, spec_text, spec_len);
+}
+
+int gp_store_progress(gp_db *db, const char *id, int percent, const char *message)
+{
+    return db_ops(db)->progress(db, id, percent, message);
+}
+
+int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
+{
+    return db_ops(db)->finish(db, id, result);
+}
+
+int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message)
+{
+    return db_ops(db)->fail(db, id, code_name, message);
+}
+
+int gp_store_requeue(gp_db *db, const char *id)
+{
+    return db_ops(db)->requeue(db, id);
+}
+
+int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
+                     int *deleted, gp_job *after)
+{
+    return db_ops(db)->dismiss(db, id, owner, before, deleted, after);
+}
+
+int gp_store_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out)
+{
+    return db_ops(db)->open_result(db, id, owner, out);
+}
+
+int gp_store_load_timings(gp_db *db, const char *id, char names[][32], double *seconds, int cap)
+{
+    return db_ops(db)->load_timings(db, id, names, seconds, cap);
+}
+
+int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS])
+{
+    return db_ops(db)->count(db, counts);
 }
 
 int gp_store_healthy(gp_db *db)
 {
-    sqlite3_stmt *s;
-    if (sqlite3_prepare_v2(db->conn, "SELECT count(*) FROM jobs", -1, &s, NULL) != SQLITE_OK)
-        return 0;
-    int ok = sqlite3_step(s) == SQLITE_ROW;
-    sqlite3_finalize(s);
-    return ok;
+    return db_ops(db)->healthy(db);
+}
+
+int gp_store_write_state(gp_store *store)
+{
+    return ops_of(store)->write_state(store);
+}
+
+int gp_store_broken(const gp_db *db)
+{
+    return db && db_ops(db)->broken(db);
 }

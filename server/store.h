@@ -1,6 +1,9 @@
-/* store.h - the job store on sqlite3: jobs, their results and statistics, in one database
- * file that stays readable with the sqlite3 shell. WAL mode, writes in BEGIN IMMEDIATE,
- * a connection per thread (gp_db), schema versioned by PRAGMA user_version.
+/* store.h - the job store: jobs, their results and statistics. Two backends behind these
+ * functions, which the HTTP side and the workers call without knowing which: sqlite3 (one
+ * database file, readable with the sqlite3 shell; WAL mode, writes in BEGIN IMMEDIATE,
+ * schema versioned by PRAGMA user_version; one node) and PostgreSQL through libpq (any
+ * number of nodes share its queue, results and limits; see gp_store_watch). A connection
+ * per thread (gp_db).
  *
  * Locking: each gp_db is used by one thread at a time (acquire/release); the store's own
  * mutex only guards its free list of connections. */
@@ -65,10 +68,62 @@ typedef struct gp_job {
 typedef struct gp_store gp_store;
 typedef struct gp_db gp_db;
 
-/* Opens (creating if needed) the database at path and migrates it to the current schema.
- * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why. The caller owns *out
- * (gp_store_close). */
-int gp_store_open(const char *path, gp_store **out, char *why, size_t why_size);
+/* Opens (creating if needed) the database at `location` and migrates it to the current
+ * schema: a PostgreSQL connection URI (postgresql://... or postgres://..., the password
+ * from the environment's PGPASSWORD or a .pgpass file) or else a sqlite file's path.
+ * On failure returns GP_SRV_EDB or GP_ENOMEM with a reason in why (never a password). The
+ * caller owns *out (gp_store_close). */
+int gp_store_open(const char *location, gp_store **out, char *why, size_t why_size);
+
+/* Whether location names a PostgreSQL database rather than a sqlite file. */
+int gp_store_location_is_pg(const char *location);
+
+/* location for a log: a URI's password, if it holds one, replaced by "***". */
+void gp_store_redact(const char *location, char *out, size_t size);
+
+/* The backend's name, "sqlite" or "postgresql" (for /health and the log). */
+const char *gp_store_kind(gp_store *store);
+
+/* How a node takes part in a store shared by nodes (PostgreSQL; sqlite ignores them). */
+typedef struct gp_store_options {
+    const char *node;     /* the node's name for people (/health, the jobs' rows) */
+    double lease_seconds; /* a claim lasts that long unless renewed (gp_store_watch) */
+    int max_attempts;     /* a job whose node died that many times fails instead */
+} gp_store_options;
+
+/* Sets the options before the first claim. Returns 0 or GP_ENOMEM. */
+int gp_store_configure(gp_store *store, const gp_store_options *options);
+
+/* The node's identity in the store: its name and what tells this run of it from others
+ * (the name alone for sqlite). Owned by the store. */
+const char *gp_store_node(gp_store *store);
+
+/* What gp_store_watch tells its caller; any callback may be NULL. Called on the watching
+ * thread. */
+typedef struct gp_store_events {
+    void *ctx;
+    void (*queued)(void *ctx);                   /* a job was queued, on some node */
+    void (*finished)(void *ctx, const char *id); /* a job reached a final status */
+    void (*lost)(void *ctx, const char *id);     /* a job this node runs is no longer its
+                                                    (dismissed on another node): stop it */
+    void (*waiting)(void *ctx, long accepted);   /* the jobs waiting, all nodes counted */
+} gp_store_events;
+
+/* The secret `name` of len bytes every node of a shared store uses (made by the first node
+ * that asks, from the kernel's random source). Returns 0 with out filled, GP_SRV_ENOTFOUND
+ * for a store that is not shared (the caller draws its own), or GP_SRV_EDB. */
+int gp_store_secret(gp_store *store, const char *name, void *out, size_t len);
+
+/* Whether several nodes may share the store: then one thread calls gp_store_watch again
+ * and again while the daemon runs. */
+int gp_store_shared(gp_store *store);
+
+/* For a shared store: waits up to `seconds` for the other nodes' news (jobs queued or
+ * finished) and reports it; renews the leases of the jobs this node runs (reporting
+ * those that are not its any more), and queues again the jobs of nodes whose leases
+ * expired, when those are due. Returns 0 or GP_SRV_EDB (the next call connects again).
+ * 0 at once for a store that is not shared. */
+int gp_store_watch(gp_store *store, const gp_store_events *events, double seconds);
 
 /* At start, the jobs a previous run left running (it died: a crash, a kill, a stop that
  * gave up on a worker): those started max_attempts times or more (their claims; a clean

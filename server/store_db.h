@@ -5,7 +5,7 @@
 
 #include <sqlite3.h>
 
-#include "store.h"
+#include "store_ops.h"
 
 enum stmt_id {
     ST_INSERT,
@@ -34,7 +34,7 @@ enum stmt_id {
 };
 
 struct gp_db {
-    gp_store *store;
+    gp_store *store; /* first: store.c reads it (gp_db_head) */
     sqlite3 *conn;
     sqlite3_stmt *stmt[ST_COUNT_OF];
     sqlite3_stmt *begin, *commit, *rollback;
@@ -43,10 +43,6 @@ struct gp_db {
     int generation; /* the store's generation when it was opened */
     gp_db *next_free;
 };
-
-/* The message of a job that was running when the daemon stopped, queued again (at
- * shutdown, or at the next start after a crash). No quote in it: store.c puts it in SQL. */
-#define GP_REQUEUE_MESSAGE "queued again: the daemon stopped while it ran"
 
 /* The statement `id` of db, prepared on first use, reset and unbound; NULL (logged, as
  * gp_db_fail) when sqlite cannot prepare it. Owned by db. */
@@ -85,16 +81,32 @@ int gp_db_end(gp_db *db, int rc);
  * the caller's transaction. Returns 0, GP_ENOMEM or a class of gp_db_fail. */
 int gp_db_write_sections(gp_db *db, const char *id, const gp_result *result);
 
-/* Fills buf with len bytes from the kernel's random source. */
-void gp_db_random_bytes(void *buf, size_t len);
-
-/* A new random version of a job's stored result: 32 hex digits and a NUL. */
-void gp_db_new_result_version(char out[33]);
-
 /* Copies the text of column col (empty when NULL) into dst, truncated to size. */
 void gp_db_copy_text(char *dst, size_t size, sqlite3_stmt *s, int col);
 
 /* Binds owner to parameter i: the name, or NULL (the statement then matches any owner). */
 void gp_db_bind_owner(sqlite3_stmt *s, int i, const char *owner);
+
+/* The sqlite backend's functions behind gp_store_sqlite_ops (store_sqlite.c), each with
+ * the contract of its gp_store_ namesake in store.h or of its entry in store_ops.h. */
+int sq_recover(gp_db *db, int max_attempts, int *requeued, int *given_up);
+int sq_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
+                  size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
+int sq_get_job(gp_db *db, const char *id, const char *owner, gp_job *out);
+int sq_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
+                 size_t limit, gp_job *out, size_t *n, int *more);
+int sq_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+             size_t *spec_len);
+int sq_progress(gp_db *db, const char *id, int percent, const char *message);
+int sq_finish(gp_db *db, const char *id, const gp_result *result);
+int sq_fail(gp_db *db, const char *id, const char *code_name, const char *message);
+int sq_requeue(gp_db *db, const char *id);
+int sq_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
+               int *deleted, gp_job *after);
+int sq_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out);
+int sq_find_section(gp_db *db, int64_t key, const char *tag, int64_t *section, uint64_t *bytes);
+int sq_read_chunk(gp_db *db, int64_t section, int64_t chunk, void *dst, size_t *len);
+int sq_load_timings(gp_db *db, const char *id, char names[][32], double *seconds, int cap);
+int sq_count(gp_db *db, long counts[GP_JOB_NSTATUS]);
 
 #endif

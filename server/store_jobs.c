@@ -1,55 +1,13 @@
 /* store_jobs.c - the job store's queries on jobs: submit (with the per-owner limit), read,
  * list, claim, progress, fail, requeue, dismiss or delete, count by status. */
 #include "store_db.h"
+#include "store_ops.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/random.h>
 
 #include "log.h"
-
-static const char *const status_names[GP_JOB_NSTATUS] = {"accepted", "running", "successful",
-                                                          "failed", "dismissed"};
-
-const char *gp_job_status_name(gp_job_status status)
-{
-    return status < GP_JOB_NSTATUS ? status_names[status] : "unknown";
-}
-
-int gp_job_status_parse(const char *name, gp_job_status *out)
-{
-    for (int i = 0; i < GP_JOB_NSTATUS; i++) {
-        if (strcmp(name, status_names[i]) == 0) {
-            *out = (gp_job_status)i;
-            return 0;
-        }
-    }
-    return GP_EINVAL;
-}
-
-void gp_db_random_bytes(void *buf, size_t len)
-{
-    size_t got = 0;
-    while (got < len) {
-        ssize_t n = getrandom((unsigned char *)buf + got, len - got, 0);
-        if (n > 0)
-            got += (size_t)n;
-    }
-}
-
-/* A random (version 4) UUID: job ids must not be guessable from one another. */
-static void new_job_id(char out[GP_JOB_ID_SIZE])
-{
-    unsigned char b[16];
-    gp_db_random_bytes(b, sizeof b);
-    b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
-    b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
-    snprintf(out, GP_JOB_ID_SIZE,
-             "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0], b[1],
-             b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14],
-             b[15]);
-}
 
 /* Reads a row of JOB_COLUMNS (store.c: the columns of ST_GET and ST_LIST). */
 static void read_job(sqlite3_stmt *s, gp_job *job)
@@ -84,18 +42,13 @@ static int count_active(gp_db *db, const char *owner, long *active)
     return rc == SQLITE_ROW ? 0 : gp_db_fail(db, "count active jobs");
 }
 
-int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
+int sq_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
                         size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
 {
     long n_active = 0;
     if (active)
         *active = 0;
-    memset(out, 0, sizeof *out);
-    new_job_id(out->id);
-    gp_timestamp_now(out->created);
-    snprintf(out->updated, sizeof out->updated, "%s", out->created);
-    snprintf(out->message, sizeof out->message, "queued");
-    out->status = GP_JOB_ACCEPTED;
+    gp_store_new_job(out, spec);
     int rc;
     sqlite3_stmt *s = gp_db_write(db, ST_INSERT, &rc);
     if (!s)
@@ -121,7 +74,6 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
     sqlite3_bind_int64(s, 9, (sqlite3_int64)spec->seed);
     sqlite3_bind_double(s, 10, spec->expected_disks);
     sqlite3_bind_text(s, 11, owner, -1, SQLITE_STATIC);
-    out->has_mesh = spec->mesh_enabled;
     if (sqlite3_step(s) == SQLITE_ROW)
         out->seq = sqlite3_column_int64(s, 0);
     else
@@ -130,7 +82,7 @@ int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const c
     return gp_db_end(db, rc);
 }
 
-int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
+int sq_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
 {
     sqlite3_stmt *s = gp_db_stmt(db, ST_GET);
     if (!s)
@@ -146,7 +98,7 @@ int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
     return rc == SQLITE_DONE ? GP_SRV_ENOTFOUND : gp_db_fail(db, "get job");
 }
 
-int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
+int sq_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
                        size_t limit, gp_job *out, size_t *n, int *more)
 {
     *n = 0;
@@ -170,7 +122,7 @@ int gp_store_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64
     return rc == SQLITE_ROW || rc == SQLITE_DONE ? 0 : gp_db_fail(db, "list jobs");
 }
 
-int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
+int sq_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
                    size_t *spec_len)
 {
     *spec_text = NULL;
@@ -215,7 +167,7 @@ int gp_store_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char
     return result;
 }
 
-int gp_store_progress(gp_db *db, const char *id, int percent, const char *message)
+int sq_progress(gp_db *db, const char *id, int percent, const char *message)
 {
     char now[GP_TIMESTAMP_SIZE];
     gp_timestamp_now(now);
@@ -251,17 +203,17 @@ static int update_running(gp_db *db, enum stmt_id which, const char *id, const c
     return gp_db_end(db, gp_db_run_one(db, s, what));
 }
 
-int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message)
+int sq_fail(gp_db *db, const char *id, const char *code_name, const char *message)
 {
     return update_running(db, ST_FAIL, id, code_name, message, "fail job");
 }
 
-int gp_store_requeue(gp_db *db, const char *id)
+int sq_requeue(gp_db *db, const char *id)
 {
     return update_running(db, ST_REQUEUE, id, GP_REQUEUE_MESSAGE, NULL, "requeue job");
 }
 
-int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
+int sq_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
                      int *deleted, gp_job *after)
 {
     *deleted = 0;
@@ -281,7 +233,7 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
     else if (rc != SQLITE_ROW)
         result = gp_db_fail(db, "dismiss: read status");
     if (result == 0)
-        gp_store_get_job(db, id, NULL, after);
+        sq_get_job(db, id, NULL, after);
     if (result == 0 && !gp_job_status_final(st)) {
         char now[GP_TIMESTAMP_SIZE];
         gp_timestamp_now(now);
@@ -294,7 +246,7 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
             result = gp_db_run(db, s, "dismiss");
         }
         if (result == 0)
-            gp_store_get_job(db, id, NULL, after);
+            sq_get_job(db, id, NULL, after);
     } else if (result == 0) {
         if (!(s = gp_db_stmt(db, ST_DELETE))) {
             result = GP_SRV_EDB;
@@ -309,7 +261,7 @@ int gp_store_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status
     return gp_db_end(db, result);
 }
 
-int gp_store_count(gp_db *db, long counts[GP_JOB_NSTATUS])
+int sq_count(gp_db *db, long counts[GP_JOB_NSTATUS])
 {
     memset(counts, 0, GP_JOB_NSTATUS * sizeof *counts);
     sqlite3_stmt *s = gp_db_stmt(db, ST_COUNT);

@@ -1,8 +1,8 @@
 /* store_results.c - the job store's queries on results: a successful job's result as
  * tagged sections (core/sections.h) cut in chunks of GP_STORE_CHUNK bytes, its
  * per-bin statistics and stage timings, written with its final status in one
- * transaction; opened again for rendering (the summary sections), and read piece by
- * piece, each piece its own short read transaction. */
+ * transaction; opened again for rendering (the summary sections), and the chunks read
+ * one by one for store_reader.c, each its own short read transaction. */
 #include "store_db.h"
 
 #include <stdio.h>
@@ -13,8 +13,9 @@
 #include "log.h"
 
 /* Writes one section and its chunks. */
-static int write_section(gp_db *db, const char *id, const gp_section *sec)
+static int write_section(void *ctx, const char *id, const gp_section *sec)
 {
+    gp_db *db = ctx;
     sqlite3_stmt *s = gp_db_stmt(db, ST_SECTION);
     if (!s)
         return GP_SRV_EDB;
@@ -50,23 +51,7 @@ static int write_section(gp_db *db, const char *id, const gp_section *sec)
 
 int gp_db_write_sections(gp_db *db, const char *id, const gp_result *result)
 {
-    gp_section sections[GP_SECTIONS_MAX];
-    size_t n;
-    int rc = gp_sections_from_result(result, sections, &n);
-    if (rc)
-        return rc;
-    for (size_t i = 0; rc == 0 && i < n; i++)
-        rc = write_section(db, id, &sections[i]);
-    gp_sections_free(sections, n);
-    return rc;
-}
-
-void gp_db_new_result_version(char out[33])
-{
-    unsigned char b[16];
-    gp_db_random_bytes(b, sizeof b);
-    for (size_t i = 0; i < sizeof b; i++)
-        snprintf(out + 2 * i, 3, "%02x", b[i]);
+    return gp_store_write_sections(id, result, write_section, db);
 }
 
 /* The result rows of a successful job; called inside the finishing transaction. */
@@ -101,7 +86,7 @@ static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
     return rc;
 }
 
-int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
+int sq_finish(gp_db *db, const char *id, const gp_result *result)
 {
     const gp_pack_stats *st = &result->stats;
     const gp_packing *p = &result->packing;
@@ -133,7 +118,7 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     sqlite3_bind_int64(s, 18, (sqlite3_int64)p->capped);
     sqlite3_bind_int64(s, 19, (sqlite3_int64)p->max_level);
     char version[33];
-    gp_db_new_result_version(version);
+    gp_store_new_result_version(version);
     sqlite3_bind_text(s, 20, version, -1, SQLITE_STATIC);
     rc = gp_db_run_one(db, s, "finish job"); /* GP_SRV_ESTATE: dismissed while it ran */
     if (rc == 0)
@@ -141,79 +126,30 @@ int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
     return gp_db_end(db, rc); /* nothing kept unless all of it is */
 }
 
-/* Reads the whole of a small section (a summary one) into a new buffer. */
-static int read_whole(gp_db *db, sqlite3_int64 section, size_t bytes, unsigned char **out)
-{
-    *out = malloc(bytes ? bytes : 1);
-    if (!*out)
-        return GP_ENOMEM;
-    size_t got = 0;
-    for (sqlite3_int64 chunk = 0; got < bytes; chunk++) {
-        sqlite3_stmt *s = gp_db_stmt(db, ST_READ_CHUNK);
-        if (!s)
-            return GP_SRV_EDB;
-        sqlite3_bind_int64(s, 1, section);
-        sqlite3_bind_int64(s, 2, chunk);
-        int rc = sqlite3_step(s);
-        size_t len = rc == SQLITE_ROW ? (size_t)sqlite3_column_bytes(s, 0) : 0;
-        if (rc == SQLITE_ROW && len <= bytes - got && len > 0)
-            memcpy(*out + got, sqlite3_column_blob(s, 0), len);
-        sqlite3_reset(s);
-        if (rc != SQLITE_ROW && rc != SQLITE_DONE)
-            return gp_db_fail(db, "read result chunk");
-        if (rc == SQLITE_DONE || len == 0 || len > bytes - got)
-            return GP_SRV_ENOTFOUND; /* deleted meanwhile, or a chunk missing */
-        got += len;
-    }
-    return 0;
-}
-
-/* Decodes the summary sections of job `id` into res->summary. */
+/* Lists the summary sections of job `id` and decodes them into res->summary. */
 static int open_summary(gp_db *db, const char *id, gp_stored_result *res)
 {
     sqlite3_stmt *s = gp_db_stmt(db, ST_SUMMARY_SECTIONS);
     if (!s)
         return GP_SRV_EDB;
     sqlite3_bind_text(s, 1, id, -1, SQLITE_STATIC);
-    struct {
-        char tag[GP_SECTION_TAG_SIZE];
-        uint32_t version;
-        sqlite3_int64 section;
-        size_t bytes;
-    } found[GP_SECTIONS_MAX];
+    gp_section_ref found[GP_SECTIONS_MAX];
     size_t n = 0;
     int rc;
     while ((rc = sqlite3_step(s)) == SQLITE_ROW && n < GP_SECTIONS_MAX) {
         gp_db_copy_text(found[n].tag, sizeof found[n].tag, s, 0);
         found[n].version = (uint32_t)sqlite3_column_int64(s, 1);
         found[n].section = sqlite3_column_int64(s, 2);
-        found[n].bytes = (size_t)sqlite3_column_int64(s, 3);
+        found[n].bytes = (uint64_t)sqlite3_column_int64(s, 3);
         n++;
     }
     sqlite3_reset(s);
     if (rc != SQLITE_ROW && rc != SQLITE_DONE)
         return gp_db_fail(db, "list result sections");
-    int have_pack = 0;
-    for (size_t i = 0; i < n; i++) {
-        unsigned char *bytes = NULL;
-        rc = read_whole(db, found[i].section, found[i].bytes, &bytes);
-        if (rc == 0)
-            rc = gp_section_decode_summary(found[i].tag, found[i].version, bytes, found[i].bytes,
-                                           &res->summary);
-        free(bytes);
-        if (rc == GP_EPARSE || rc == GP_EINVAL) {
-            gp_log("store: job %s: its result section %s (version %u) cannot be decoded", id,
-                   found[i].tag, found[i].version);
-            return GP_SRV_EDB;
-        }
-        if (rc)
-            return rc;
-        have_pack |= strcmp(found[i].tag, GP_SECTION_PACK) == 0;
-    }
-    return have_pack ? 0 : GP_SRV_ENOTFOUND;
+    return gp_store_decode_summary(db, id, found, n, &res->summary);
 }
 
-int gp_store_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out)
+int sq_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out)
 {
     memset(out, 0, sizeof *out);
     sqlite3_stmt *s = gp_db_stmt(db, ST_OPEN_RESULT);
@@ -248,103 +184,40 @@ int gp_store_open_result(gp_db *db, const char *id, const char *owner, gp_stored
     return result;
 }
 
-void gp_stored_result_free(gp_stored_result *r)
+int sq_find_section(gp_db *db, int64_t key, const char *tag, int64_t *section, uint64_t *bytes)
 {
-    free(r->spec_text);
-    gp_result_free(&r->summary);
-    memset(r, 0, sizeof *r);
-}
-
-/* The reader's cache: for each section read so far, where it is and its last chunk. */
-typedef struct reader_section {
-    char tag[GP_SECTION_TAG_SIZE];
-    sqlite3_int64 id;
-    uint64_t bytes;
-    sqlite3_int64 chunk; /* the chunk held in data, -1: none */
-    unsigned char *data;
-    size_t len;
-} reader_section;
-
-struct gp_result_reader {
-    int64_t key;
-    reader_section sections[GP_SECTIONS_MAX];
-    size_t n;
-};
-
-gp_result_reader *gp_result_reader_new(int64_t key)
-{
-    gp_result_reader *r = calloc(1, sizeof *r);
-    if (r)
-        r->key = key;
-    return r;
-}
-
-void gp_result_reader_free(gp_result_reader *r)
-{
-    if (!r)
-        return;
-    for (size_t i = 0; i < r->n; i++)
-        free(r->sections[i].data);
-    free(r);
-}
-
-/* The reader's entry of section `tag`, looked up in the store on first use. */
-static int find_section(gp_result_reader *r, gp_db *db, const char *tag, reader_section **out)
-{
-    for (size_t i = 0; i < r->n; i++) {
-        if (strcmp(r->sections[i].tag, tag) == 0) {
-            *out = &r->sections[i];
-            return 0;
-        }
-    }
-    if (r->n == GP_SECTIONS_MAX)
-        return GP_SRV_ENOTFOUND;
     sqlite3_stmt *s = gp_db_stmt(db, ST_FIND_SECTION);
     if (!s)
         return GP_SRV_EDB;
-    sqlite3_bind_int64(s, 1, r->key);
+    sqlite3_bind_int64(s, 1, key);
     sqlite3_bind_text(s, 2, tag, -1, SQLITE_STATIC);
     int rc = sqlite3_step(s);
-    reader_section *sec = &r->sections[r->n];
     if (rc == SQLITE_ROW) {
-        memset(sec, 0, sizeof *sec);
-        snprintf(sec->tag, sizeof sec->tag, "%s", tag);
-        sec->id = sqlite3_column_int64(s, 0);
-        sec->bytes = (uint64_t)sqlite3_column_int64(s, 1);
-        sec->chunk = -1;
+        *section = sqlite3_column_int64(s, 0);
+        *bytes = (uint64_t)sqlite3_column_int64(s, 1);
     }
     sqlite3_reset(s);
     if (rc == SQLITE_DONE)
         return GP_SRV_ENOTFOUND;
-    if (rc != SQLITE_ROW)
-        return gp_db_fail(db, "find result section");
-    if (!(sec->data = malloc(GP_STORE_CHUNK)))
-        return GP_ENOMEM;
-    r->n++;
-    *out = sec;
-    return 0;
+    return rc == SQLITE_ROW ? 0 : gp_db_fail(db, "find result section");
 }
 
-/* Brings chunk `chunk` of sec into its cache: one query, its own read transaction. */
-static int load_chunk(gp_db *db, reader_section *sec, sqlite3_int64 chunk)
+int sq_read_chunk(gp_db *db, int64_t section, int64_t chunk, void *dst, size_t *len)
 {
-    if (sec->chunk == chunk)
-        return 0;
     sqlite3_stmt *s = gp_db_stmt(db, ST_READ_CHUNK);
     if (!s)
         return GP_SRV_EDB;
-    sqlite3_bind_int64(s, 1, sec->id);
+    sqlite3_bind_int64(s, 1, section);
     sqlite3_bind_int64(s, 2, chunk);
     int rc = sqlite3_step(s), result = 0;
     if (rc == SQLITE_ROW) {
-        size_t len = (size_t)sqlite3_column_bytes(s, 0);
-        if (len > GP_STORE_CHUNK) {
+        size_t n = (size_t)sqlite3_column_bytes(s, 0);
+        if (n > GP_STORE_CHUNK) {
             result = GP_SRV_EDB;
         } else {
-            if (len)
-                memcpy(sec->data, sqlite3_column_blob(s, 0), len);
-            sec->len = len;
-            sec->chunk = chunk;
+            if (n)
+                memcpy(dst, sqlite3_column_blob(s, 0), n);
+            *len = n;
         }
     } else {
         result = rc == SQLITE_DONE ? GP_SRV_ENOTFOUND : gp_db_fail(db, "read result chunk");
@@ -353,33 +226,7 @@ static int load_chunk(gp_db *db, reader_section *sec, sqlite3_int64 chunk)
     return result;
 }
 
-int gp_result_reader_read(gp_result_reader *r, gp_db *db, const char *tag, uint64_t offset,
-                          void *dst, size_t len)
-{
-    reader_section *sec;
-    int rc = find_section(r, db, tag, &sec);
-    if (rc)
-        return rc;
-    if (offset > sec->bytes || len > sec->bytes - offset)
-        return GP_SRV_ENOTFOUND;
-    unsigned char *to = dst;
-    while (len > 0) {
-        sqlite3_int64 chunk = (sqlite3_int64)(offset / GP_STORE_CHUNK);
-        size_t at = (size_t)(offset % GP_STORE_CHUNK);
-        if ((rc = load_chunk(db, sec, chunk)))
-            return rc;
-        if (at >= sec->len)
-            return GP_SRV_ENOTFOUND; /* a chunk shorter than the section says */
-        size_t n = sec->len - at < len ? sec->len - at : len;
-        memcpy(to, sec->data + at, n);
-        to += n;
-        offset += n;
-        len -= n;
-    }
-    return 0;
-}
-
-int gp_store_load_timings(gp_db *db, const char *id, char names[][32], double *seconds, int cap)
+int sq_load_timings(gp_db *db, const char *id, char names[][32], double *seconds, int cap)
 {
     sqlite3_stmt *s = gp_db_stmt(db, ST_TIMINGS);
     if (!s)

@@ -119,7 +119,7 @@ static int convert(gp_db *db, const char *id, char *why, size_t why_size)
         rc = gp_db_write_sections(db, id, &result);
     if (rc == 0) {
         char version[33];
-        gp_db_new_result_version(version);
+        gp_store_new_result_version(version);
         sqlite3_stmt *s;
         if (sqlite3_prepare_v2(db->conn, "UPDATE jobs SET result_version = ?2 WHERE id = ?1", -1,
                                &s, NULL) != SQLITE_OK)

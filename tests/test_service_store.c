@@ -3,9 +3,8 @@
  * version 2's own DDL with the disks-only results of that time, is upgraded in place: its
  * jobs are readable, its results serve every format (F and the cells derived once, at the
  * upgrade), new results are stored whole; a result is read piece by piece and a reader
- * stops cleanly when the job is deleted under it; jobs are seen only by their owner (NULL
- * sees all); the per-owner limit counts accepted and running jobs in the inserting
- * transaction. */
+ * stops cleanly when the job is deleted under it. What every backend must do is in
+ * test_store_contract.c. */
 #include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,17 +29,6 @@ static void remove_database(void)
         snprintf(p, sizeof p, "%s%s", db_path, suffix[i]);
         unlink(p);
     }
-}
-
-static gp_spec small_spec(void)
-{
-    const char *text = "{\"inputs\": {\"domain\": {\"width\": 10, \"height\": 10},"
-                       " \"distribution\": {\"kind\": \"constant\", \"radius\": 0.9}}}";
-    gp_spec spec;
-    gp_error err;
-    if (gp_spec_parse(text, strlen(text), NULL, &spec, &err) != 0)
-        abort();
-    return spec;
 }
 
 /* A store on a new database file, and a connection to it. */
@@ -335,64 +323,6 @@ static void test_a_reader_stops_when_the_job_is_deleted_under_it(void)
     gp_store_close(store);
 }
 
-static void test_jobs_are_seen_by_their_owner_only(void)
-{
-    gp_store *store;
-    gp_db *db = open_fresh(&store);
-    gp_spec spec = small_spec();
-    gp_job a, b, got, list[8];
-    CHECK(gp_store_insert_job(db, "alice", 0, "{}", 2, &spec, &a, NULL) == 0);
-    CHECK(gp_store_insert_job(db, "bob", 0, "{}", 2, &spec, &b, NULL) == 0);
-    CHECK(gp_store_get_job(db, a.id, "alice", &got) == 0);
-    CHECK(gp_store_get_job(db, a.id, "bob", &got) == GP_SRV_ENOTFOUND);
-    CHECK(gp_store_get_job(db, a.id, NULL, &got) == 0);
-    size_t n;
-    int more;
-    CHECK(gp_store_list_jobs(db, "bob", 0, 0, 8, list, &n, &more) == 0);
-    CHECK(n == 1 && strcmp(list[0].id, b.id) == 0);
-    CHECK(gp_store_list_jobs(db, NULL, 0, 0, 8, list, &n, &more) == 0 && n == 2);
-    gp_job_status before;
-    int deleted;
-    CHECK(gp_store_dismiss(db, a.id, "bob", &before, &deleted, &got) == GP_SRV_ENOTFOUND);
-    CHECK(gp_store_get_job(db, a.id, "alice", &got) == 0 && got.status == GP_JOB_ACCEPTED);
-    CHECK(gp_store_dismiss(db, a.id, "alice", &before, &deleted, &got) == 0 && !deleted);
-    CHECK(gp_store_dismiss(db, b.id, NULL, &before, &deleted, &got) == 0 && !deleted);
-    gp_spec_free(&spec);
-    gp_store_release(store, db);
-    gp_store_close(store);
-}
-
-static void test_the_owner_limit_counts_accepted_and_running_jobs(void)
-{
-    gp_store *store;
-    gp_db *db = open_fresh(&store);
-    gp_spec spec = small_spec();
-    gp_job j1, j2, j3, other;
-    long active = -1;
-    CHECK(gp_store_insert_job(db, "alice", 2, "{}", 2, &spec, &j1, &active) == 0 && active == 0);
-    char id[GP_JOB_ID_SIZE], *text;
-    size_t len;
-    atomic_long queued;
-    atomic_init(&queued, 1); /* the claim takes the job out of the caller's count */
-    CHECK(gp_store_claim(db, &queued, id, &text, &len) == 0 && strcmp(id, j1.id) == 0); /* running */
-    CHECK(atomic_load(&queued) == 0);
-    free(text);
-    CHECK(gp_store_insert_job(db, "alice", 2, "{}", 2, &spec, &j2, &active) == 0 && active == 1);
-    CHECK(gp_store_insert_job(db, "alice", 2, "{}", 2, &spec, &j3, &active) == GP_SRV_ELIMIT);
-    CHECK(active == 2);
-    CHECK(gp_store_insert_job(db, "bob", 2, "{}", 2, &spec, &other, &active) == 0 && active == 0);
-    CHECK(gp_store_insert_job(db, "alice", 0, "{}", 2, &spec, &j3, NULL) == 0); /* 0: no limit */
-    gp_job_status before;
-    int deleted;
-    gp_job after;
-    CHECK(gp_store_fail(db, j1.id, "test", "done") == 0);
-    CHECK(gp_store_dismiss(db, j3.id, NULL, &before, &deleted, &after) == 0);
-    CHECK(gp_store_insert_job(db, "alice", 2, "{}", 2, &spec, &j3, &active) == 0 && active == 1);
-    gp_spec_free(&spec);
-    gp_store_release(store, db);
-    gp_store_close(store);
-}
-
 int main(void)
 {
     if (!mkdtemp(dir))
@@ -401,8 +331,6 @@ int main(void)
     RUN(test_a_version_1_database_migrates_and_keeps_its_jobs);
     RUN(test_a_version_2_database_is_upgraded_with_its_results);
     RUN(test_a_reader_stops_when_the_job_is_deleted_under_it);
-    RUN(test_jobs_are_seen_by_their_owner_only);
-    RUN(test_the_owner_limit_counts_accepted_and_running_jobs);
     remove_database();
     rmdir(dir);
     return check_status();
