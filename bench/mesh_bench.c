@@ -3,7 +3,8 @@
  * without band_layers, side by side with Gmsh meshing the same grains and band (written
  * as a .geo file, run as `gmsh -2`, one thread, its Delaunay algorithm, its element size
  * tuned to give about as many triangles). Prints markdown.
- * Usage: grainpack_mesh_bench [--quick] [--no-gmsh] [--no-gmsh-large] EXAMPLES_DIR
+ * Usage: grainpack_mesh_bench [--quick] [--no-gmsh] [--no-gmsh-large] [--only iron|fixed|large]
+ *                             [--layers 0|2] EXAMPLES_DIR
  * (--no-gmsh-large: Gmsh on the iron and fixed cases only; on 10^5 grains it runs for
  * hours on a loaded machine). */
 #include <math.h>
@@ -49,6 +50,14 @@ static double cpu_seconds(const struct rusage *u)
            (double)u->ru_stime.tv_sec + 1e-6 * (double)u->ru_stime.tv_usec;
 }
 
+/* The mesh stage alone, never inlined: profilers single it out by name
+ * (`valgrind --tool=callgrind --toggle-collect=mesh_stage`, `perf report --parent`). */
+__attribute__((noinline)) static int mesh_stage(const gp_mesh_input *in, const gp_mesh_params *params,
+                                                gp_mesh *mesh, gp_error *err)
+{
+    return gp_mesh_build(in, params, NULL, mesh, err);
+}
+
 /* The mesh stage on the structure `r`, in a child process: its time and the growth of
  * its peak resident memory. */
 static measure grainpack_mesh(const gp_spec *spec, const gp_result *r)
@@ -66,7 +75,7 @@ static measure grainpack_mesh(const gp_spec *spec, const gp_result *r)
         gp_mesh mesh;
         gp_error err;
         double t0 = now();
-        if (gp_mesh_build(&in, &spec->mesh, NULL, &mesh, &err))
+        if (mesh_stage(&in, &spec->mesh, &mesh, &err))
             die("mesh", &err);
         measure m = {now() - t0, 0, 0, (double)(mesh.ntri + mesh.nquad), (double)mesh.ntri,
                      (double)mesh.nquad, 0};
@@ -231,6 +240,9 @@ static void row(const char *name, size_t grains, int layers, const measure *g, c
     fflush(stdout);
 }
 
+/* Which rows of a case run (--layers): both, or only the one without or with layers. */
+static enum { ROWS_BOTH, ROWS_PLAIN, ROWS_LAYERS } rows = ROWS_BOTH;
+
 static void bench_case(const char *name, gp_spec *spec, int with_gmsh, const char *tmp,
                        double *cl_ratio, int one_run)
 {
@@ -243,14 +255,18 @@ static void bench_case(const char *name, gp_spec *spec, int with_gmsh, const cha
     if (gp_pipeline_run(spec, 0, NULL, &r, &err))
         die(name, &err);
     gp_mesh_params_default(&spec->dist, &spec->mesh);
-    measure plain = grainpack_mesh(spec, &r);
-    measure gm = {0};
-    if (with_gmsh)
-        gm = gmsh_matched(spec, &r, plain.triangles, tmp, cl_ratio, one_run);
-    row(name, r.packing.count, 0, &plain, with_gmsh ? &gm : NULL);
-    spec->mesh.band_layers = 2;
-    measure layers = grainpack_mesh(spec, &r);
-    row(name, r.packing.count, 2, &layers, NULL);
+    if (rows != ROWS_LAYERS) {
+        measure plain = grainpack_mesh(spec, &r);
+        measure gm = {0};
+        if (with_gmsh)
+            gm = gmsh_matched(spec, &r, plain.triangles, tmp, cl_ratio, one_run);
+        row(name, r.packing.count, 0, &plain, with_gmsh ? &gm : NULL);
+    }
+    if (rows != ROWS_PLAIN) {
+        spec->mesh.band_layers = 2;
+        measure layers = grainpack_mesh(spec, &r);
+        row(name, r.packing.count, 2, &layers, NULL);
+    }
     gp_result_free(&r);
 }
 
@@ -266,7 +282,7 @@ static void load(const char *dir, const char *name, gp_spec *spec)
 int main(int argc, char **argv)
 {
     int quick = 0, gmsh = 1, gmsh_large = 1;
-    const char *dir = NULL;
+    const char *dir = NULL, *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--quick") == 0)
             quick = 1;
@@ -274,12 +290,16 @@ int main(int argc, char **argv)
             gmsh = 0;
         else if (strcmp(argv[i], "--no-gmsh-large") == 0)
             gmsh_large = 0;
+        else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
+        else if (strcmp(argv[i], "--layers") == 0 && i + 1 < argc)
+            rows = strcmp(argv[++i], "0") == 0 ? ROWS_PLAIN : ROWS_LAYERS;
         else
             dir = argv[i];
     }
     if (!dir) {
         fprintf(stderr, "usage: grainpack_mesh_bench [--quick] [--no-gmsh] [--no-gmsh-large] "
-                        "EXAMPLES_DIR\n");
+                        "[--only iron|fixed|large] [--layers 0|2] EXAMPLES_DIR\n");
         return 2;
     }
     char tmp[] = "/tmp/grainpack_mesh_bench.XXXXXX";
@@ -299,14 +319,17 @@ int main(int argc, char **argv)
            "| grainpack faster by (CPU per element) |\n"
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     gp_spec spec;
-    load(dir, "iron", &spec);
     double cl_ratio = 1.0;
-    bench_case("iron", &spec, gmsh, tmp, &cl_ratio, 0);
-    gp_spec_free(&spec);
+    if (!only || strcmp(only, "iron") == 0) {
+        load(dir, "iron", &spec);
+        bench_case("iron", &spec, gmsh, tmp, &cl_ratio, 0);
+        gp_spec_free(&spec);
+    }
     load(dir, "fixed", &spec);
     cl_ratio = 1.0;
-    bench_case("fixed", &spec, gmsh, tmp, &cl_ratio, 0);
-    if (!quick) {
+    if (!only || strcmp(only, "fixed") == 0)
+        bench_case("fixed", &spec, gmsh, tmp, &cl_ratio, 0);
+    if (only ? strcmp(only, "large") == 0 : !quick) {
         /* the fixed case scaled to 10^5 grains: it holds about 2,790 in 100 x 100 */
         double side = 100.0 * sqrt(1e5 / 2790.0);
         spec.domain = (gp_domain){side, side};

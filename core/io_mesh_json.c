@@ -18,12 +18,13 @@ json_t *gp_mesh_statistics_json(const gp_spec *spec, const gp_mesh *mesh)
     const char *second = mesh->kind == GP_MESH_CELLS ? NULL
                          : mesh->kind == GP_MESH_DISKS_IN_MATRIX ? "matrix" : "grain_boundary";
     return json_pack(
-        "{s:s, s:{s:f, s:f, s:i, s:i, s:f}, s:I, s:{s:I, s:I, s:I}, s:I, s:{s:f, s:f, s:I, s:f},"
+        "{s:s, s:{s:f, s:f, s:i, s:i, s:f, s:b}, s:I, s:{s:I, s:I, s:I}, s:I, s:{s:f, s:f, s:I, s:f},"
         " s:{s:f, s:f, s:o, s:s}, s:{s:f, s:f, s:f, s:f, s:f, s:s?, s:f, s:f}, s:I,"
         " s:{s:I, s:f, s:f}}",
         "kind", kind_names[mesh->kind],
         "options", "element_size", p->element_size, "min_angle", p->min_angle, "order", p->order,
         "band_layers", p->band_layers, "band_size", p->band_size,
+        "grading", mesh->kind == GP_MESH_GRAINS_AND_BAND && p->grading,
         "nodes", (json_int_t)s->nodes,
         "elements", "triangles", (json_int_t)s->triangles, "quadrilaterals", (json_int_t)s->quads,
         "total", (json_int_t)(s->triangles + s->quads),

@@ -202,19 +202,22 @@ static int second_order(gp_mesh *mesh, gp_pair_map *edges, const gp_progress *pr
     return rc;
 }
 
-/* The side of the domain an edge lies on, or -1. */
-static int edge_side(const gp_mesh *mesh, const gp_domain *d, int32_t u, int32_t v)
+/* The sides of the domain node k lies on, a bit (1 << side) for each. */
+static unsigned node_sides(const gp_mesh *mesh, const gp_domain *d, size_t k)
 {
-    double ux = mesh->xy[2 * u], uy = mesh->xy[2 * u + 1];
-    double vx = mesh->xy[2 * v], vy = mesh->xy[2 * v + 1];
-    if (ux == 0.0 && vx == 0.0)
-        return GP_SIDE_LEFT;
-    if (ux == d->width && vx == d->width)
-        return GP_SIDE_RIGHT;
-    if (uy == 0.0 && vy == 0.0)
-        return GP_SIDE_BOTTOM;
-    if (uy == d->height && vy == d->height)
-        return GP_SIDE_TOP;
+    double x = mesh->xy[2 * k], y = mesh->xy[2 * k + 1];
+    return (unsigned)(x == 0.0) << GP_SIDE_LEFT | (unsigned)(x == d->width) << GP_SIDE_RIGHT |
+           (unsigned)(y == 0.0) << GP_SIDE_BOTTOM | (unsigned)(y == d->height) << GP_SIDE_TOP;
+}
+
+/* The side of the domain an edge lies on (the first, in the order of gp_mesh_side, that
+ * both its nodes are on), or -1. */
+static int edge_side(const uint8_t *sides, int32_t u, int32_t v)
+{
+    unsigned both = sides[u] & sides[v];
+    for (int side = 0; both; side++, both >>= 1)
+        if (both & 1u)
+            return side;
     return -1;
 }
 
@@ -225,6 +228,11 @@ static int boundary_edges(gp_mesh *mesh, const gp_domain *d, const gp_pair_map *
 {
     size_t cap = 0, n = 0, side_cap = 0;
     int stride = mesh->order + 1;
+    uint8_t *sides = malloc(mesh->nnodes ? mesh->nnodes : 1);
+    if (!sides)
+        return oom(err);
+    for (size_t k = 0; k < mesh->nnodes; k++)
+        sides[k] = (uint8_t)node_sides(mesh, d, k);
     for (int quads = 0; quads < 2; quads++) {
         size_t count = quads ? mesh->nquad : mesh->ntri;
         int corners = quads ? 4 : 3, nodes = quads ? gp_mesh_quad_nodes(mesh->order) : gp_mesh_tri_nodes(mesh->order);
@@ -233,12 +241,14 @@ static int boundary_edges(gp_mesh *mesh, const gp_domain *d, const gp_pair_map *
             const int32_t *c = conn + (size_t)nodes * e;
             for (int k = 0; k < corners; k++) {
                 int32_t u = c[k], v = c[(k + 1) % corners];
-                int side = edge_side(mesh, d, u, v);
+                int side = edge_side(sides, u, v);
                 if (side < 0)
                     continue;
                 if (gp_mesh_reserve((void **)&mesh->bedge, &cap, (size_t)stride * (n + 1), sizeof *mesh->bedge) ||
-                    gp_mesh_reserve((void **)&mesh->bedge_side, &side_cap, n + 1, sizeof *mesh->bedge_side))
+                    gp_mesh_reserve((void **)&mesh->bedge_side, &side_cap, n + 1, sizeof *mesh->bedge_side)) {
+                    free(sides);
                     return oom(err);
+                }
                 mesh->bedge[stride * n] = u;
                 mesh->bedge[stride * n + 1] = v;
                 if (mesh->order == 2)
@@ -247,6 +257,7 @@ static int boundary_edges(gp_mesh *mesh, const gp_domain *d, const gp_pair_map *
             }
         }
     }
+    free(sides);
     mesh->nbedges = n;
     return 0;
 }
@@ -278,6 +289,8 @@ int gp_mesh_build(const gp_mesh_input *in, const gp_mesh_params *params,
     gp_cdt_params cp = {
         .size_bound = params->element_size,
         .shape_bound = sine * sine,
+        .graded_region = geo.kind == GP_MESH_GRAINS_AND_BAND && params->grading ? (int32_t)geo.ngrains : -1,
+        .graded_size = params->band_size,
         .max_triangles = in->max_elements,
         .expected_triangles = expected_triangles(&geo, in->domain, params->element_size),
         .progress = progress,

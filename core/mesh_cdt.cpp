@@ -28,6 +28,7 @@
 #include <CGAL/Spatial_sort_traits_adapter_2.h>
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
+#include <boost/container/small_vector.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +37,7 @@
 #include <cstring>
 #include <deque>
 #include <exception>
+#include <initializer_list>
 #include <new>
 #include <numeric>
 #include <unordered_set>
@@ -46,7 +48,8 @@ namespace {
 typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
 
 // CGAL's mesh vertex, plus the input point it stands for (-1: a Steiner point), its node
-// number in the output, and whether it ends a protected segment.
+// number in the output, whether it ends a protected segment, and the graded region's
+// local size there.
 template <class Gt, class Vb = CGAL::Delaunay_mesh_vertex_base_2<Gt>>
 class Vertex_base : public Vb {
 public:
@@ -58,6 +61,7 @@ public:
     int32_t input = -1;
     int32_t node = -1;
     bool guarded = false;
+    double size = HUGE_VAL; // graded meshes: the local target edge length of the band here
 };
 
 // CGAL's mesh face, plus its place in the stack of bad faces and its region.
@@ -115,35 +119,186 @@ public:
     }
 };
 
+} // namespace
+
+// The conflict zone of one insertion (the faces a new point destroys and the edges around
+// them), for both levels of the mesher. CGAL's generic one keeps them in std::lists: a
+// heap node per face and per edge, made and freed at every insertion, was 40% of the
+// stage's instructions (callgrind, iron: 300 of 743 million in new/delete). Here the
+// same interface on vectors that hold a usual zone without the heap.
+template <> struct CGAL::Triangulation_mesher_level_traits_2<Cdt> : public CGAL::Triangulation_ref_impl<Cdt> {
+    typedef Cdt Triangulation;
+    typedef Cdt::Point Point;
+    typedef Cdt::Vertex_handle Vertex_handle;
+    typedef Cdt::Face_handle Face_handle;
+    typedef Cdt::Edge Edge;
+    using CGAL::Triangulation_ref_impl<Cdt>::triangulation_ref_impl;
+
+    explicit Triangulation_mesher_level_traits_2(Cdt &t) : CGAL::Triangulation_ref_impl<Cdt>(t) {}
+
+    struct Zone {
+        // A circumcentre destroys 4 to 5 faces on average, rarely more than a dozen; the
+        // boundary of n faces has n + 2 edges. Larger zones spill to the heap.
+        typedef boost::container::small_vector<Face_handle, 16> Faces;
+        typedef boost::container::small_vector<Edge, 18> Edges;
+        typedef Faces::iterator Faces_iterator;
+        typedef Edges::iterator Edges_iterator;
+        Cdt::Locate_type locate_type;
+        Face_handle fh;
+        int i;
+        Face_handle parent_face; // the face whose circumcentre is inserted, if any
+        Faces faces;
+        Edges boundary_edges;
+    };
+
+    Vertex_handle insert_impl(const Point &p, Zone &zone)
+    {
+        if (zone.locate_type == Cdt::VERTEX)
+            return zone.fh->vertex(zone.i);
+        return triangulation_ref_impl().star_hole(p, zone.boundary_edges.begin(), zone.boundary_edges.end(),
+                                                  zone.faces.begin(), zone.faces.end());
+    }
+};
+
+namespace {
+
 typedef Cdt::Vertex_handle Vertex_handle;
 typedef Cdt::Face_handle Face_handle;
 typedef Cdt::Point Point;
-typedef CGAL::Delaunay_mesh_size_criteria_2<Cdt> Criteria;
-typedef CGAL::Mesh_2::Is_locally_conforming_Gabriel<Cdt> Gabriel;
+// The graded region's local size is the band's thickness times this: elements about as
+// long as the band is thick (issue 11), one row of triangles across a strip.
+const double GRADED_SIZE_PER_THICKNESS = 1.5;
 
-// CGAL's segment test (a segment is encroached when a point sees it at a right or obtuse
-// angle), except that a protected segment is never encroached: it is never split.
-struct Gabriel_unless_protected : Gabriel {
+// The size of a face of the graded region: the fixed size when one is asked, else the
+// smallest local size of its corners (HUGE_VAL where none was measured).
+double graded_face_size(const Face_handle &fh, double fixed)
+{
+    if (fixed > 0.0)
+        return fixed;
+    return std::min(fh->vertex(0)->size, std::min(fh->vertex(1)->size, fh->vertex(2)->size));
+}
+
+// The local size a new vertex inherits from the corners of what it splits: their mean
+// over those that have one. (The smallest would spread, one insertion after the other,
+// the smallest size of the band to all of it.)
+double inherited_size(std::initializer_list<Vertex_handle> corners)
+{
+    double sum = 0.0;
+    int n = 0;
+    for (const Vertex_handle &v : corners)
+        if (v->size < HUGE_VAL) {
+            sum += v->size;
+            n++;
+        }
+    return n ? sum / n : HUGE_VAL;
+}
+
+// CGAL's criteria (Delaunay_mesh_size_criteria_2: a face is imperatively bad when its
+// longest edge is over the size bound, bad when its smallest angle's squared sine is under
+// the shape bound), except that the size bound of a face of the graded region (the band)
+// is its own (graded_face_size) when smaller than the element size.
+struct Criteria {
+    typedef CGAL::Delaunay_mesh_size_criteria_2<Cdt>::Quality Quality;
+    double shape_bound, size_bound; // 0: no size bound
+    int32_t graded_region;          // -1: none
+    double graded_size;             // 0: the corners' local sizes
+
+    double face_size(const Face_handle &fh) const
+    {
+        if (graded_region < 0 || fh->region != graded_region)
+            return size_bound;
+        double s = graded_face_size(fh, graded_size);
+        return size_bound > 0.0 && size_bound < s ? size_bound : s;
+    }
+
+    struct Is_bad {
+        const Criteria &c;
+        CGAL::Mesh_2::Face_badness operator()(const Quality &q) const
+        {
+            if (q.size() > 1.0)
+                return CGAL::Mesh_2::IMPERATIVELY_BAD;
+            return q.sine() < c.shape_bound ? CGAL::Mesh_2::BAD : CGAL::Mesh_2::NOT_BAD;
+        }
+        CGAL::Mesh_2::Face_badness operator()(const Face_handle &fh, Quality &q) const
+        {
+            const Point &a = fh->vertex(0)->point(), &b = fh->vertex(1)->point(), &p = fh->vertex(2)->point();
+            double abx = b.x() - a.x(), aby = b.y() - a.y(), apx = p.x() - a.x(), apy = p.y() - a.y();
+            double bpx = p.x() - b.x(), bpy = p.y() - b.y();
+            double la = bpx * bpx + bpy * bpy, lb = apx * apx + apy * apy, lc = abx * abx + aby * aby;
+            if (la < lb) // sorted: la >= lb >= lc
+                std::swap(la, lb);
+            if (lb < lc)
+                std::swap(lb, lc);
+            if (la < lb)
+                std::swap(la, lb);
+            double longest = la, second = lb;
+            double h = c.face_size(fh);
+            q.second = h > 0.0 && h < HUGE_VAL ? longest / (h * h) : 0.0;
+            if (q.second > 1.0) {
+                q.first = 1.0; // the sine does not matter: the face is split anyway
+                return CGAL::Mesh_2::IMPERATIVELY_BAD;
+            }
+            double twice_area = abx * apy - aby * apx;
+            q.first = twice_area * twice_area / (longest * second);
+            return q.first < c.shape_bound ? CGAL::Mesh_2::BAD : CGAL::Mesh_2::NOT_BAD;
+        }
+    };
+    Is_bad is_bad_object() const { return Is_bad{*this}; }
+};
+// The double-precision dot product below decides its sign when it exceeds this fraction of
+// the sum of its two terms' magnitudes: its rounding error is at most 4 units in the last
+// place of that sum (two differences, a product, a sum), 9e-16 of it; 1e-14 leaves room.
+const double DOT_SIGN_FILTER = 1e-14;
+// ... and when that sum is above this: no product underflowed.
+const double DOT_SIGN_FILTER_MIN = 1e-250;
+
+// Whether p sees the segment ab at an acute angle (it does not encroach the segment):
+// (a - p).(b - p) > 0, in doubles when their rounding cannot change the sign, else by
+// CGAL's exact Angle_2. Angle_2 alone (interval arithmetic for every call) was 6% of the
+// stage's instructions (callgrind, iron).
+bool sees_acute(const Point &a, const Point &p, const Point &b)
+{
+    double ax = a.x() - p.x(), ay = a.y() - p.y(), bx = b.x() - p.x(), by = b.y() - p.y();
+    double xx = ax * bx, yy = ay * by, dot = xx + yy, mag = std::fabs(xx) + std::fabs(yy);
+    if (std::fabs(dot) > DOT_SIGN_FILTER * mag && mag > DOT_SIGN_FILTER_MIN)
+        return dot > 0.0;
+    return CGAL::angle(a, p, b) == CGAL::ACUTE;
+}
+
+// CGAL's segment test (Is_locally_conforming_Gabriel: a segment is encroached when a
+// point sees it at a right or obtuse angle), with the filtered test above, except that a
+// protected segment is never encroached: it is never split.
+struct Gabriel_unless_protected {
+    // the segment of edge i of fh, against the two vertices facing it
     bool operator()(const Cdt &tr, const Face_handle &fh, const int i) const
     {
-        if (tr.is_protected(fh->vertex(Cdt::cw(i)), fh->vertex(Cdt::ccw(i))))
+        const Vertex_handle &a = fh->vertex(Cdt::cw(i)), &b = fh->vertex(Cdt::ccw(i));
+        if (tr.is_protected(a, b))
             return true;
-        return Gabriel::operator()(tr, fh, i);
+        const Vertex_handle &c = fh->vertex(i);
+        Vertex_handle d = tr.tds().mirror_vertex(fh, i);
+        return (tr.is_infinite(c) || sees_acute(a->point(), c->point(), b->point())) &&
+               (tr.is_infinite(d) || sees_acute(a->point(), d->point(), b->point()));
     }
     bool operator()(const Cdt &tr, const Vertex_handle &va, const Vertex_handle &vb) const
     {
-        return tr.is_protected(va, vb) || Gabriel::operator()(tr, va, vb);
+        if (tr.is_protected(va, vb))
+            return true;
+        Face_handle fh;
+        int i = 0;
+        if (!tr.is_edge(va, vb, fh, i))
+            return true; /* not reached: CGAL asks about edges of the triangulation */
+        return (*this)(tr, fh, i);
     }
+    // the segment against a point about to be inserted
     bool operator()(const Cdt &tr, const Face_handle &fh, const int i, const Point &p) const
     {
-        if (tr.is_protected(fh->vertex(Cdt::cw(i)), fh->vertex(Cdt::ccw(i))))
-            return true;
-        return Gabriel::operator()(tr, fh, i, p);
+        return (*this)(tr, fh->vertex(Cdt::cw(i)), fh->vertex(Cdt::ccw(i)), p);
     }
     bool operator()(const Cdt &tr, const Vertex_handle &va, const Vertex_handle &vb,
                     const Point &p) const
     {
-        return tr.is_protected(va, vb) || Gabriel::operator()(tr, va, vb, p);
+        return tr.is_protected(va, vb) || sees_acute(va->point(), p, vb->point());
     }
 };
 
@@ -175,6 +330,8 @@ protected:
     Previous &previous;
     std::vector<Entry> stack;
     CGAL::Mesh_2::Face_badness current_badness = CGAL::Mesh_2::NOT_BAD;
+    int32_t inserted_region = -1; // of the face whose circumcentre is going in
+    double inserted_size = HUGE_VAL;
 
     void push(const Face_handle &f, const Quality &q)
     {
@@ -259,7 +416,7 @@ public:
             const Face_handle &f = e->first;
             Vertex_handle a = f->vertex(Tr::cw(e->second)), b = f->vertex(Tr::ccw(e->second));
             if (f->is_constrained(e->second) && t.is_protected(a, b) &&
-                !Gabriel()(t, a, b, p))
+                !sees_acute(a->point(), p, b->point()))
                 inside = false;
         }
         if (inside)
@@ -267,20 +424,29 @@ public:
         dropped++;
         return CGAL::CONFLICT_AND_ELEMENT_SHOULD_BE_DROPPED;
     }
-    void before_insertion_impl(const Face_handle &, const Point &, Zone &zone)
+    // fh: the face whose circumcentre goes in (its zone, bounded by segments, is all of
+    // its region), or none when the segment level splits a segment (its visitor then
+    // restores the marks on each side)
+    void before_insertion_impl(const Face_handle &fh, const Point &, Zone &zone)
     {
         for (auto f = zone.faces.begin(); f != zone.faces.end(); ++f) {
             if ((*f)->is_in_domain())
                 remove(*f);
             (*f)->set_in_domain(false);
         }
+        if (fh != Face_handle()) {
+            inserted_region = fh->region;
+            inserted_size = inherited_size({fh->vertex(0), fh->vertex(1), fh->vertex(2)});
+        }
     }
     void after_insertion_impl(const Vertex_handle &v)
     {
         auto fc = triangulation_ref_impl().incident_faces(v), done = fc;
-        do
+        do {
             fc->set_in_domain(true);
-        while (++fc != done);
+            fc->region = inserted_region;
+        } while (++fc != done);
+        v->size = inserted_size;
         compute_new_bad_faces(v);
     }
     template <typename E, typename Z> void after_no_insertion_impl(const E &, const Point &, Z &) {}
@@ -298,6 +464,83 @@ public:
 
 typedef Stack_faces_base<Cdt, Criteria, Edges_level> Faces_base;
 typedef CGAL::Mesh_2::Refine_faces<Cdt, Criteria, Edges_level, Faces_base> Faces_level;
+
+// The visitors of the two levels (CGAL's Refine_edges_visitor and its faces-level
+// wrapper), which also carry the region of each side of a segment across its split: the
+// graded criteria need the region of every face during the refinement. Mesher levels
+// pass visitors by value: what a split remembers lives in Edge_split, owned by the caller.
+struct Edge_split {
+    Vertex_handle a, b;
+    bool in_domain_right, in_domain_left;
+    int32_t region_right, region_left;
+};
+
+class Edges_visitor : public CGAL::Null_mesh_visitor {
+    Faces_level *faces;
+    Edge_split *split;
+
+public:
+    typedef Cdt::Edge Edge;
+    typedef CGAL::Triangulation_mesher_level_traits_2<Cdt>::Zone Zone;
+
+    Edges_visitor(Faces_level &f, Edge_split &s) : faces(&f), split(&s) {}
+    CGAL::Null_mesh_visitor previous_level() const { return CGAL::Null_mesh_visitor(); }
+
+    void before_conflicts(const Edge &e, const Point &)
+    {
+        const Face_handle &right = e.first, &left = e.first->neighbor(e.second);
+        split->a = right->vertex(Cdt::cw(e.second));
+        split->b = right->vertex(Cdt::ccw(e.second));
+        split->in_domain_right = right->is_in_domain();
+        split->in_domain_left = left->is_in_domain();
+        split->region_right = right->region;
+        split->region_left = left->region;
+    }
+    void before_insertion(const Edge &, const Point &p, Zone &z)
+    {
+        faces->before_insertion_impl(Face_handle(), p, z);
+    }
+    // the faces around v from [a, v] to [v, b] counter-clockwise were at the right of
+    // [a, b], the others at its left
+    void after_insertion(const Vertex_handle &v)
+    {
+        Cdt &t = faces->triangulation_ref_impl();
+        Face_handle fh;
+        int i = 0;
+        t.is_edge(split->a, v, fh, i);
+        auto fc = t.incident_faces(v, fh), start = fc;
+        do {
+            if (!t.is_infinite(fc)) {
+                fc->set_in_domain(split->in_domain_right);
+                fc->region = split->region_right;
+            }
+            ++fc;
+        } while (fc->vertex(Cdt::ccw(fc->index(v))) != split->b);
+        do {
+            if (!t.is_infinite(fc)) {
+                fc->set_in_domain(split->in_domain_left);
+                fc->region = split->region_left;
+            }
+            ++fc;
+        } while (fc != start);
+        v->size = inherited_size({split->a, split->b});
+        faces->compute_new_bad_faces(v);
+    }
+    template <typename E, typename P, typename Z> void after_no_insertion(const E &, const P &, const Z &) const {}
+};
+
+// (CGAL's takes the zone by value: a copy of it at every insertion.)
+class Faces_visitor {
+    Edges_visitor edges;
+
+public:
+    Faces_visitor(Faces_level &f, Edge_split &s) : edges(f, s) {}
+    Edges_visitor &previous_level() { return edges; }
+    template <typename E, typename P> void before_conflicts(const E &, const P &) const {}
+    template <typename E, typename P, typename Z> void before_insertion(const E &, const P &, const Z &) const {}
+    template <typename V> void after_insertion(const V &) const {}
+    template <typename E, typename P, typename Z> void after_no_insertion(const E &, const P &, const Z &) const {}
+};
 
 // Refinement steps between two looks at the cancel flag: each step inserts at most one
 // point (about a microsecond), so a few milliseconds.
@@ -459,30 +702,34 @@ struct Run {
 
     int refine()
     {
-        Criteria criteria(params.shape_bound, params.size_bound);
+        Criteria criteria{params.shape_bound, params.size_bound, params.graded_region, params.graded_size};
         CGAL::Null_mesher_level null_level;
-        CGAL::Null_mesh_visitor null_visitor;
         CGAL::Mesh_2::Clusters<Cdt> clusters(cdt);
         Edges_level edges(cdt, clusters, null_level);
         Faces_level faces(cdt, criteria, edges);
-        CGAL::Mesh_2::Refine_edges_visitor_from_faces<Faces_level> visitor(faces, edges, null_visitor);
+        Edge_split split;
+        Faces_visitor visitor(faces, split);
         clusters.create_clusters();
         edges.scan_triangulation();
         faces.scan_triangulation();
         unsigned steps = 0;
+        // the data structure's count, infinite faces included: Triangulation_2's own
+        // walks around the infinite vertex (every node on the domain's sides) to leave
+        // them out, a cache miss each, which was 14% of the stage on 10^5 grains (perf)
+        const Cdt::Triangulation_data_structure &tds = cdt.tds();
         while (!faces.is_algorithm_done()) {
             faces.one_step(visitor);
             if (++steps % STEPS_PER_CHECK)
                 continue;
             if (canceled())
                 return cancel_error();
-            if (params.max_triangles && cdt.number_of_faces() > params.max_triangles)
+            if (params.max_triangles && tds.number_of_faces() > params.max_triangles)
                 return gp_error_set(err, GP_ETOOBIG, NULL,
                                     "mesh: more than %zu elements; ask for a larger element_size "
                                     "or raise the limit",
                                     params.max_triangles);
             if (params.expected_triangles > 0.0)
-                report(static_cast<double>(cdt.number_of_faces()) / params.expected_triangles);
+                report(static_cast<double>(tds.number_of_faces()) / params.expected_triangles);
         }
         dropped += faces.dropped;
         return 0;
@@ -607,6 +854,46 @@ struct Run {
         return 0;
     }
 
+    // The regions from the seeds again, from scratch: the refinement keeps them on its
+    // new faces, but the mirrored strip nodes and the output take them from here.
+    int relabel()
+    {
+        for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+            f->region = -1;
+        return label();
+    }
+
+    // Each vertex of the graded region's outline gets its local size: the band's
+    // thickness there, the distance from a face's segment (a grain's outline or the
+    // domain's side) to the face's opposite corner (on the facing outline: no cell is
+    // concave), the smallest over the faces of the region around it, times
+    // GRADED_SIZE_PER_THICKNESS.
+    void measure_graded_sizes()
+    {
+        for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+            if (f->region != params.graded_region)
+                continue;
+            for (int i = 0; i < 3; i++) {
+                Vertex_handle o = f->vertex(i), a = f->vertex(Cdt::cw(i)), b = f->vertex(Cdt::ccw(i));
+                // a strip's end runs across the band, not along it
+                if (!f->is_constrained(i) || cdt.is_protected(a, b))
+                    continue;
+                double ex = b->point().x() - a->point().x(), ey = b->point().y() - a->point().y();
+                double ox = o->point().x() - a->point().x(), oy = o->point().y() - a->point().y();
+                double len2 = ex * ex + ey * ey;
+                if (!(len2 > 0.0))
+                    continue;
+                // to the segment, not its line: a corner beyond the segment's end (at a
+                // junction) may lie near the line and far from the segment
+                double t = std::min(1.0, std::max(0.0, (ox * ex + oy * ey) / len2));
+                double dx = ox - t * ex, dy = oy - t * ey;
+                double size = GRADED_SIZE_PER_THICKNESS * std::sqrt(dx * dx + dy * dy);
+                for (Vertex_handle v : {o, a, b})
+                    v->size = std::min(v->size, size);
+            }
+        }
+    }
+
     template <typename T> static T *alloc(size_t n)
     {
         return static_cast<T *>(malloc((n ? n : 1) * sizeof(T)));
@@ -682,12 +969,17 @@ struct Run {
             if (last && (rc = settle_strips(true, &matched)))
                 return rc;
             mark_holes();
+            // the graded criteria need every face's region from the start
+            if (params.graded_region >= 0 && (rc = relabel()))
+                return rc;
+            if (params.graded_region >= 0 && rounds == 1)
+                measure_graded_sizes();
             if ((rc = refine()) || (rc = settle_strips(false, &matched)))
                 return rc;
             if (last && !matched)
                 return gp_error_set(err, GP_EINTERNAL, NULL, "mesh: protected strip sides were split");
         }
-        if ((rc = label()))
+        if ((rc = params.graded_region >= 0 ? relabel() : label()))
             return rc;
         if (cdt.number_of_vertices() > static_cast<size_t>(INT32_MAX))
             return gp_error_set(err, GP_ETOOBIG, NULL, "mesh: more than %d nodes", INT32_MAX);

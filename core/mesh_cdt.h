@@ -51,6 +51,10 @@ void gp_pslg_free(gp_pslg *g);
 typedef struct gp_cdt_params {
     double size_bound;        /* the longest edge allowed (0: none) */
     double shape_bound;       /* sin^2 of the smallest angle allowed (0: none) */
+    int32_t graded_region;    /* the region whose faces get a size bound of their own (the
+                                 band), or -1 */
+    double graded_size;       /* that bound (when under size_bound), or 0: the region's
+                                 local thickness, measured on its outline before refining */
     size_t max_triangles;     /* GP_ETOOBIG beyond this (0: no cap) */
     double expected_triangles;/* for progress: the fraction reported is faces / this */
     const gp_progress *progress; /* stage "mesh"; may be NULL */
@@ -75,8 +79,9 @@ typedef struct gp_cdt_mesh {
 
 /* Inserts the points and segments of `g` in a CGAL constrained Delaunay triangulation,
  * refines it (CGAL's Delaunay mesher: encroached segments split, bad triangles get their
- * circumcentre) until no triangle has an edge over size_bound or an angle under the
- * shape bound, except where that would split a protected segment, mirrors the splits of
+ * circumcentre) until no triangle has an edge over size_bound (over its own bound in
+ * the graded region) or an angle under the shape bound, except where that would split a
+ * protected segment, mirrors the splits of
  * strip sides onto the facing sides and refines again until they match (the last round
  * protects the sides), then labels the triangles by region. Returns 0 and fills `out` (free with gp_cdt_mesh_free), or
  * GP_ENOMEM, GP_ECANCELED, GP_ETOOBIG, GP_EGEOM (a seed's region leaks into another's, or

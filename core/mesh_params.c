@@ -59,6 +59,7 @@ void gp_mesh_params_default(const gp_distribution *dist, gp_mesh_params *params)
     params->order = 1;
     params->band_layers = 0;
     params->band_size = 0.0;
+    params->grading = 1;
     params->disk_tolerance = GP_MESH_DEFAULT_DISK_TOLERANCE;
     params->plane = GP_MESH_PLANE_STRESS;
     params->reduced = 0;

@@ -510,9 +510,9 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"element_size", "min_angle", "order", "band_layers",
-                                          "band_size", "disk_tolerance", "abaqus", NULL};
+                                          "band_size", "grading", "disk_tolerance", "abaqus", NULL};
     if ((rc = check_members(v, obj, ptr, members,
-                            "element_size, min_angle, order, band_layers, band_size, "
+                            "element_size, min_angle, order, band_layers, band_size, grading, "
                             "disk_tolerance, abaqus")))
         return rc;
     gp_mesh_params *m = &spec->mesh;
@@ -523,6 +523,7 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
         (rc = get_integer(v, obj, ptr, "order", 1, 2, &m->order)) ||
         (rc = get_integer(v, obj, ptr, "band_layers", 0, GP_MESH_MAX_BAND_LAYERS, &m->band_layers)) ||
         (rc = get_bounded(v, obj, ptr, "band_size", 0.0, 1, SPEC_MAX_ELEMENT_SIZE, &m->band_size)) ||
+        (rc = get_bool(v, obj, ptr, "grading", &m->grading)) ||
         (rc = get_bounded(v, obj, ptr, "disk_tolerance", 0.0, 1, 0.25, &m->disk_tolerance)) ||
         (rc = parse_abaqus(v, obj, ptr, m)))
         return rc;
@@ -532,10 +533,19 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
                             "needs \"laguerre\": {\"shrink\": \"offset\"} (the band's strips have "
                             "parallel sides only between offset cells)");
     }
-    if (json_object_get(obj, "band_size") && m->band_layers == 0) {
+    int band = spec->laguerre_enabled && spec->laguerre.shrink != GP_SHRINK_NONE;
+    static const char *const band_options[] = {"band_size", "grading"};
+    for (size_t k = 0; k < sizeof band_options / sizeof *band_options; k++)
+        if (json_object_get(obj, band_options[k]) && !band) {
+            pointer_key(member, ptr, band_options[k]);
+            return gp_error_set(v->err, GP_EINVAL, member,
+                                "sizes the grain-boundary band: it needs \"laguerre\": {\"shrink\": "
+                                "\"offset\"} or \"homothetic\"");
+        }
+    if (json_object_get(obj, "band_size") && !m->grading && m->band_layers == 0) {
         pointer_key(member, ptr, "band_size");
-        return gp_error_set(v->err, GP_EINVAL, member, "is the length of the band's quadrilaterals: "
-                                                       "it needs band_layers >= 1");
+        return gp_error_set(v->err, GP_EINVAL, member, "sizes nothing with \"grading\": false and no "
+                                                       "band_layers");
     }
     if (json_object_get(obj, "disk_tolerance") && spec->laguerre_enabled) {
         pointer_key(member, ptr, "disk_tolerance");

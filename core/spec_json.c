@@ -53,8 +53,9 @@ static json_t *joint_json(const gp_joint *j, int *failed)
     return o;
 }
 
-/* The "mesh" object: band_size only with band layers and disk_tolerance only without
- * cells, as the parser refuses them elsewhere (the result must parse again). */
+/* The "mesh" object: band_size and grading only with a band (and band_size only where it
+ * sizes something), disk_tolerance only without cells, as the parser refuses them
+ * elsewhere (the result must parse again). */
 static json_t *mesh_json(const gp_spec *spec, int *failed)
 {
     const gp_mesh_params *m = &spec->mesh;
@@ -63,8 +64,11 @@ static json_t *mesh_json(const gp_spec *spec, int *failed)
     put(o, "min_angle", json_real(m->min_angle), failed);
     put(o, "order", json_integer(m->order), failed);
     put(o, "band_layers", json_integer(m->band_layers), failed);
-    if (m->band_layers > 0 && m->band_size > 0.0)
+    int band = spec->laguerre_enabled && spec->laguerre.shrink != GP_SHRINK_NONE;
+    if (band && m->band_size > 0.0 && (m->grading || m->band_layers > 0))
         put(o, "band_size", json_real(m->band_size), failed);
+    if (band)
+        put(o, "grading", json_boolean(m->grading), failed);
     if (!spec->laguerre_enabled)
         put(o, "disk_tolerance", json_real(m->disk_tolerance), failed);
     put(o, "abaqus", json_pack("{s:s, s:b}", "plane",

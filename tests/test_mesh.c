@@ -7,6 +7,7 @@
  * quadrilaterals, exactly n of them across every strip, triangles only where strips do
  * not reach; order 2 nodes at mid-edges; cancellation; the same spec, the same mesh. */
 #include <jansson.h>
+#include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
@@ -472,6 +473,88 @@ static void test_mesh_reference_examples(void)
     }
 }
 
+/* The mean edge length of the band's triangles (each edge counted per triangle), and of
+ * the grains' interior edges (neither end on an outline: no band triangle there), of the
+ * mesh of `json`; the result's statistics in *stats. Returns 0 or -1. */
+static int phase_edges(const char *json, double *band_mean, double *grain_mean, gp_mesh_stats *stats)
+{
+    gp_spec spec;
+    gp_result res;
+    if (load(json, &spec))
+        return -1;
+    if (run(&spec, &res)) {
+        gp_spec_free(&spec);
+        return -1;
+    }
+    const gp_mesh *m = &res.mesh;
+    char *outline = calloc(m->nnodes, 1);
+    for (size_t t = 0; t < m->ntri; t++)
+        if (gp_mesh_region_phase(m, m->tri_region[t]) != GP_PHASE_GRAIN)
+            for (int k = 0; k < 3; k++)
+                outline[element(m, 0, t)[k]] = 1;
+    double sum[2] = {0, 0};
+    size_t n[2] = {0, 0};
+    for (size_t t = 0; t < m->ntri; t++) {
+        const int32_t *c = element(m, 0, t);
+        int band = gp_mesh_region_phase(m, m->tri_region[t]) != GP_PHASE_GRAIN;
+        for (int k = 0; k < 3; k++) {
+            int32_t u = c[k], v = c[(k + 1) % 3];
+            if (!band && (outline[u] || outline[v]))
+                continue;
+            sum[band] += hypot(m->xy[2 * u] - m->xy[2 * v], m->xy[2 * u + 1] - m->xy[2 * v + 1]);
+            n[band]++;
+        }
+    }
+    free(outline);
+    *grain_mean = n[0] ? sum[0] / (double)n[0] : 0.0;
+    *band_mean = n[1] ? sum[1] / (double)n[1] : 0.0;
+    *stats = m->stats;
+    gp_result_free(&res);
+    gp_spec_free(&spec);
+    return 0;
+}
+
+/* Grains of radius 6 with a joint of 0.15 (a band about 0.3 thick), element_size 1.5. */
+#define GRADED_LAW                                                                                   \
+    "\"domain\": {\"width\": 48, \"height\": 48}, \"distribution\": {\"kind\": \"constant\", "        \
+    "\"radius\": 6}, \"joint\": {\"law\": \"constant\", \"value\": 0.15}, "                           \
+    "\"laguerre\": {\"shrink\": \"offset\"}"
+
+static void test_mesh_band_graded_to_its_thickness(void)
+{
+    char json[1024];
+    for (int seed = 1; seed <= 1; seed++) { /* (a constant law packs alike from any seed) */
+        double graded, graded_grain, plain, plain_grain, fixed, fixed_grain, unused;
+        gp_mesh_stats strips, s;
+        /* the band's thickness, measured on its straight strips by the geometry */
+        snprintf(json, sizeof json, "{" GRADED_LAW ", \"seed\": %d, \"mesh\": {\"element_size\": 1.5, "
+                 "\"band_layers\": 1}}", seed);
+        if (phase_edges(json, &unused, &unused, &strips))
+            continue;
+        CHECK(strips.band_strips > 0 && strips.band_thickness_mean > 0.2);
+        double t = strips.band_thickness_mean;
+        snprintf(json, sizeof json, "{" GRADED_LAW ", \"seed\": %d, \"mesh\": {\"element_size\": 1.5}}", seed);
+        CHECK(phase_edges(json, &graded, &graded_grain, &s) == 0);
+        CHECK(s.below_min_angle == 0 && s.min_angle >= GP_MESH_MAX_MIN_ANGLE - 1e-9);
+        snprintf(json, sizeof json, "{" GRADED_LAW ", \"seed\": %d, \"mesh\": {\"element_size\": 1.5, "
+                 "\"grading\": false}}", seed);
+        CHECK(phase_edges(json, &plain, &plain_grain, &s) == 0);
+        snprintf(json, sizeof json, "{" GRADED_LAW ", \"seed\": %d, \"mesh\": {\"element_size\": 1.5, "
+                 "\"band_size\": 0.1}}", seed);
+        CHECK(phase_edges(json, &fixed, &fixed_grain, &s) == 0);
+        CHECK(s.below_min_angle == 0);
+        /* the band's edges track its thickness; without grading they are longer */
+        CHECK_MSG(graded > 0.5 * t && graded < 1.5 * t, "band edges %g, thickness %g", graded, t);
+        CHECK_MSG(plain > 1.25 * graded, "ungraded band edges %g, graded %g", plain, graded);
+        CHECK_MSG(fixed > 0.05 && fixed < 0.1, "band_size 0.1: band edges %g", fixed);
+        /* the grains' interiors stay coarse: their edges (away from the outlines, where the
+         * mesh grades from the band's size) about as long as without grading */
+        CHECK_MSG(graded_grain > 0.5 * 1.5 && graded_grain < 1.5 && graded_grain > 0.75 * plain_grain,
+                  "grain interior edges %g (without grading %g)", graded_grain, plain_grain);
+        (void)fixed_grain;
+    }
+}
+
 static void cancel_in_mesh(void *ctx, const char *stage, double fraction)
 {
     gp_cancel_flag *flag = ctx;
@@ -545,6 +628,7 @@ int main(void)
     RUN(test_mesh_cells_conform_across_cells);
     RUN(test_mesh_disks_in_matrix);
     RUN(test_mesh_band_layers);
+    RUN(test_mesh_band_graded_to_its_thickness);
     RUN(test_mesh_reference_examples);
     RUN(test_mesh_cancel);
     RUN(test_mesh_deterministic);

@@ -61,6 +61,18 @@ static void test_mesh_options_read(void)
     CHECK(spec.mesh.order == 2 && spec.mesh.band_layers == 3 && spec.mesh.reduced);
     CHECK(spec.mesh.plane == GP_MESH_PLANE_STRAIN);
     CHECK_NEAR(spec.mesh.band_size, 0.1, 0);
+    CHECK(spec.mesh.grading == 1);
+    gp_spec_free(&spec);
+    /* band_size sizes the band's triangles too: no band_layers needed; grading is read */
+    rc = parse("{\"inputs\": {" LAW ", \"laguerre\": {\"shrink\": \"homothetic\"}, \"mesh\": "
+               "{\"band_size\": 0.2}}}", NULL, &spec, &err);
+    CHECK_MSG(rc == 0, "%s %s", err.pointer, err.message);
+    CHECK(spec.mesh.grading == 1 && spec.mesh.band_size == 0.2);
+    gp_spec_free(&spec);
+    rc = parse("{\"inputs\": {" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": "
+               "{\"grading\": false}}}", NULL, &spec, &err);
+    CHECK_MSG(rc == 0, "%s %s", err.pointer, err.message);
+    CHECK(spec.mesh.grading == 0);
     gp_spec_free(&spec);
 }
 
@@ -79,8 +91,15 @@ static void test_mesh_bad_options_refused_with_pointer(void)
             GP_EINVAL, "/mesh/band_layers", "offset");
     refused("{" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 65}}",
             GP_EINVAL, "/mesh/band_layers", "from 0 to 64");
-    refused("{" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_size\": 0.1}}",
-            GP_EINVAL, "/mesh/band_size", "band_layers");
+    refused("{" LAW ", \"mesh\": {\"band_size\": 0.1}}", GP_EINVAL, "/mesh/band_size", "shrink");
+    refused("{" LAW ", \"laguerre\": {\"shrink\": \"none\"}, \"mesh\": {\"grading\": true}}", GP_EINVAL,
+            "/mesh/grading", "shrink");
+    refused("{" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"grading\": 1}}", GP_EINVAL,
+            "/mesh/grading", "true or false");
+    refused("{" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_size\": 0}}", GP_EINVAL,
+            "/mesh/band_size", "(0,");
+    refused("{" LAW ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"grading\": false, "
+            "\"band_size\": 0.1}}", GP_EINVAL, "/mesh/band_size", "grading");
     refused("{" LAW ", \"mesh\": {\"disk_tolerance\": 0.5}}", GP_EINVAL, "/mesh/disk_tolerance", "0.25]");
     refused("{" LAW ", \"laguerre\": {\"shrink\": \"none\"}, \"mesh\": {\"disk_tolerance\": 0.1}}",
             GP_EINVAL, "/mesh/disk_tolerance", "Laguerre");

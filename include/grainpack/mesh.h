@@ -52,8 +52,11 @@ typedef struct gp_mesh_params {
     int order;             /* 1, or 2 for mid-edge nodes (TRI6, QUAD8) */
     int band_layers;       /* 0: the band is triangles; n: n layers of quadrilaterals across
                               every straight strip of the band (needs offset cells) */
-    double band_size;      /* with band_layers: the quads' length along a strip; 0: the
-                              strip's thickness */
+    double band_size;      /* the band's target edge length (its triangles with grading,
+                              the quads' length along a strip with band_layers); 0: the
+                              band's local thickness */
+    int grading;           /* 1: the band's triangles are graded to band_size (shrunk
+                              cells only); 0: sized by element_size and min_angle alone */
     double disk_tolerance; /* without cells: outline-to-arc distance / radius, (0, 0.25] */
     gp_mesh_plane plane;   /* Abaqus element types */
     int reduced;           /* Abaqus: reduced integration for quadrilaterals (CPS4R, CPS8R) */
@@ -155,7 +158,8 @@ GP_API double gp_mesh_element_quality(const gp_mesh *mesh, int quad, size_t inde
 GP_API double gp_mesh_element_area(const gp_mesh *mesh, int quad, size_t index);
 
 /* The default parameters: element size GP_MESH_DEFAULT_SIZE_RATIO times the mean grain
- * radius of `dist`, the largest guaranteed minimum angle, order 1, no layers. */
+ * radius of `dist`, the largest guaranteed minimum angle, order 1, no layers, the band graded to
+ * its local thickness. */
 GP_API void gp_mesh_params_default(const gp_distribution *dist, gp_mesh_params *params);
 
 /* The mean grain radius of a law. */

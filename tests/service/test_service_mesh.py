@@ -46,6 +46,8 @@ def bad_specs():
     homothetic["inputs"]["laguerre"] = {"shrink": "homothetic"}
     not_object = mesh_spec()
     not_object["inputs"]["mesh"] = 3
+    no_band_size = mesh_spec(band_size=0.5)
+    no_band_size["inputs"]["laguerre"] = {"shrink": "none"}
     invalid = "urn:grainpack:problem:invalid-spec"
     return [
         ("zero size", mesh_spec(element_size=0), invalid, "/inputs/mesh/element_size"),
@@ -55,7 +57,9 @@ def bad_specs():
         ("negative layers", mesh_spec(band_layers=-1), invalid, "/inputs/mesh/band_layers"),
         ("layers without cells", no_cells, invalid, "/inputs/mesh/band_layers"),
         ("layers with homothetic cells", homothetic, invalid, "/inputs/mesh/band_layers"),
-        ("band_size without layers", mesh_spec(band_size=0.5), invalid, "/inputs/mesh/band_size"),
+        ("band_size sizing nothing", mesh_spec(band_size=0.5, grading=False), invalid, "/inputs/mesh/band_size"),
+        ("band_size without a band", no_band_size, invalid, "/inputs/mesh/band_size"),
+        ("grading not a boolean", mesh_spec(grading=1), invalid, "/inputs/mesh/grading"),
         ("unknown option", mesh_spec(size=1), invalid, "/inputs/mesh/size"),
         ("unknown plane", mesh_spec(abaqus={"plane": "axisymmetric"}), invalid, "/inputs/mesh/abaqus/plane"),
         ("not an object", not_object, invalid, "/inputs/mesh"),

@@ -148,7 +148,7 @@ def check_validation(c, api, client, daemon):
     c.check(inputs["balance"] == {"method": "relocation", "max_iterations": 30, "max_step": 1.0}, f"balance {inputs['balance']}")
     c.check(inputs["laguerre"] == {"shrink": "offset", "flush_boundary": False}, f"laguerre {inputs['laguerre']}")
     c.check(inputs["mesh"] == {"element_size": 4, "min_angle": 20.7048, "order": 1, "band_layers": 1,
-                               "abaqus": {"plane": "stress", "reduced_integration": False}}, f"mesh {inputs['mesh']}")
+                               "grading": True, "abaqus": {"plane": "stress", "reduced_integration": False}}, f"mesh {inputs['mesh']}")
     c.check(inputs["distribution"] == spec["inputs"]["distribution"], "the bins are not given back as sent")
     c.check(answer["limits"]["max_disks"] == 2000000 and answer["limits"]["max_bins"] == 10000, f"limits {answer['limits']}")
     # the defaults written out, and the normalised spec a fixed point of validation
