@@ -50,26 +50,27 @@ GP_API const char *gp_balance_method_name(gp_balance_method method);
 #define GP_BALANCE_STALL_SWEEPS 20
 
 /* On a large structure the relocation's sweeps never stop moving centres (at 10^6 grains
- * a tenth of the centres still move at sweep 20), and the structure stops improving long
+ * one centre in twelve still moves at sweep 20), and the structure stops improving long
  * before the stall rule ends it: F_max is held from the first sweeps on by one void no
- * move closes, and the mean F, lowest after 2 to 4 sweeps, creeps up by 1e-4 a sweep (a
- * relative 3e-4) while it swings by twice that from one sweep to the next, centres in
- * cycles of two sweeps jumping back and forth (variable law, 10^5 and 10^6 grains, 2026-11-24).
+ * move closes, and the mean F, lowest after 2 to 4 sweeps, creeps back up (1e-4 a sweep
+ * at 10^5 grains, 5e-5 at 10^6) while it swings by up to 3e-4 from one sweep to the next,
+ * centres in cycles of two sweeps jumping back and forth (variable law, 2026-11-24).
  * A relocation of at least GP_BALANCE_STEADY_MIN_INTERIOR interior centres also stops,
  * "steady", after GP_BALANCE_STEADY_SWEEPS sweeps in a row that did not lower the lowest
  * F_max seen and lowered the lowest mean F seen by less than GP_BALANCE_STEADY_RTOL of it
  * (relative); it returns to the best structure seen, as the other stops do. (A first rule
  * asked the means of the last five structures to lie within 5e-4 of each other: the
- * swings and the creep kept it from ever firing on the densest packings.) Why these
- * values: on 36 relocations of 3x10^4 to 10^5 grains, both first steps, and the Bagi
- * case, this rule returns the structure the stall rule returned but in one (5x10^4 grains,
- * F_max 2.86 for 2.82 and a lower mean), after 7 to 28 sweeps instead of 10 to 42; with 4
- * sweeps instead of 6 it lost two more. On a thousand grains, and still on 10^4, the best
- * structure comes by chance after long runs without progress (variable, 10^4 grains: best
- * at sweeps 25 and 31 of 12 runs, F_max 2.79 and 2.72 where this rule would stop at 3.38
- * and 2.92; the reference cases: up to 16 sweeps without progress before the best), so
- * smaller structures keep the stall rule alone. Laplacian smoothing does not take this
- * rule: its moves die out and it ends "converged". */
+ * swings and the creep kept it from firing on the densest packings.) Why these values: on
+ * 39 relocations (3x10^4, 5x10^4 and 10^5 grains with both first steps, the Bagi case,
+ * 10^6 grains) this rule returns the structure the stall rule returned but in one (5x10^4
+ * grains: F_max 2.86 for 2.82, and a lower mean), after 7 to 28 sweeps instead of 10 to
+ * 42; with 4 sweeps instead of 6 it lost two more (bench/GEOM_RESULTS.md). On a thousand
+ * grains, and still on 10^4, the best structure comes by chance after long runs without
+ * progress (variable, 10^4 grains: best at sweeps 25 and 31 in two of 12 runs, F_max 2.79
+ * and 2.72 where this rule would stop at 3.38 and 2.92; the reference cases: up to 16
+ * sweeps without progress before the best), so smaller structures keep the stall rule
+ * alone. Laplacian smoothing does not take this rule: its moves die out and it ends
+ * "converged". */
 #define GP_BALANCE_STEADY_RTOL 5e-4
 #define GP_BALANCE_STEADY_SWEEPS 6
 #define GP_BALANCE_STEADY_MIN_INTERIOR 25000
