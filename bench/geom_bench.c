@@ -309,8 +309,9 @@ static void bench_updates(const char *dir, double max_grains, int quick)
 
 static void bench_relocation(const char *dir, double max_grains)
 {
-    printf("### Relocation to the end (default options: flips, stop when a sweep moves nothing or %d "
-           "sweeps bring no progress)\n\n", GP_BALANCE_STALL_SWEEPS);
+    printf("### Relocation to the end (default options: flips, stop when a sweep moves nothing, %d "
+           "sweeps bring no progress, or from %d interior centres %d sweeps no meaningful progress)\n\n",
+           GP_BALANCE_STALL_SWEEPS, GP_BALANCE_STEADY_MIN_INTERIOR, GP_BALANCE_STEADY_SWEEPS);
     printf("| grains | sweeps | stop | best sweep | time | per sweep | F_max | mean F | overlaps after | MB |\n"
            "|---|---|---|---|---|---|---|---|---|---|\n");
     for (double g = 1e4; g <= max_grains * 1.01; g *= 10) {

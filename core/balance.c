@@ -273,16 +273,16 @@ static int improves(const gp_quality_stats *a, const gp_quality_stats *best)
     return a->max <= best->max && a->mean < best->mean - GP_BALANCE_QUALITY_TOL;
 }
 
-/* Whether the mean F of the last GP_BALANCE_STEADY_SWEEPS + 1 structures (the sweeps'
- * and the one before them) lie within GP_BALANCE_STEADY_RTOL of `mean`. */
-static int steady(const double *means, double mean)
+/* Whether a relocation is steady (GP_BALANCE_STEADY_MIN_INTERIOR): F_max not lowered for
+ * GP_BALANCE_STEADY_SWEEPS sweeps, and `lowest_mean`, the lowest mean F seen, less than
+ * GP_BALANCE_STEADY_RTOL below `lowest_before`, the lowest seen GP_BALANCE_STEADY_SWEEPS
+ * sweeps ago. */
+static int steady(const balancer *b, size_t interior, uint32_t since_lowered_max, double lowest_before,
+                  double lowest_mean)
 {
-    double lo = means[0], hi = means[0];
-    for (int k = 1; k <= GP_BALANCE_STEADY_SWEEPS; k++) {
-        lo = means[k] < lo ? means[k] : lo;
-        hi = means[k] > hi ? means[k] : hi;
-    }
-    return hi - lo < GP_BALANCE_STEADY_RTOL * mean;
+    return b->method == GP_BALANCE_RELOCATION && interior >= GP_BALANCE_STEADY_MIN_INTERIOR &&
+           since_lowered_max >= GP_BALANCE_STEADY_SWEEPS &&
+           lowest_before - lowest_mean < GP_BALANCE_STEADY_RTOL * lowest_mean;
 }
 
 static void save_best(balancer *b)
@@ -345,9 +345,10 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
      * in two different structures, tell whether the sweeps still make progress */
     gp_quality_stats best = out->before, now;
     double lowest_max = best.max, lowest_mean = best.mean;
-    /* the mean F of the last structures (round robin), and when F_max was last lowered */
-    double means[GP_BALANCE_STEADY_SWEEPS + 1];
-    means[0] = out->before.mean;
+    /* the lowest mean after each of the last sweeps (round robin), and when F_max was
+     * last lowered */
+    double lowest_means[GP_BALANCE_STEADY_SWEEPS];
+    lowest_means[0] = lowest_mean;
     uint32_t lowered_max = 0;
     save_best(b);
     out->stop = GP_BALANCE_STOP_CAP;
@@ -371,21 +372,24 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
             save_best(b);
         }
         int lower_max = now.max < lowest_max - GP_BALANCE_QUALITY_TOL;
+        int lower_mean = now.mean < lowest_mean - GP_BALANCE_QUALITY_TOL;
         lowered_max = lower_max ? out->sweeps : lowered_max;
-        means[out->sweeps % (GP_BALANCE_STEADY_SWEEPS + 1)] = now.mean;
-        if (b->method == GP_BALANCE_RELOCATION && out->sweeps - lowered_max >= GP_BALANCE_STEADY_SWEEPS &&
-            steady(means, now.mean)) {
+        lowest_max = now.max < lowest_max ? now.max : lowest_max;
+        lowest_mean = now.mean < lowest_mean ? now.mean : lowest_mean;
+        /* the slot of the sweep GP_BALANCE_STEADY_SWEEPS ago, overwritten below */
+        double *slot = &lowest_means[out->sweeps % GP_BALANCE_STEADY_SWEEPS];
+        if (out->sweeps >= GP_BALANCE_STEADY_SWEEPS &&
+            steady(b, now.interior, out->sweeps - lowered_max, *slot, lowest_mean)) {
             out->stop = GP_BALANCE_STOP_STEADY;
             break;
         }
-        if (lower_max || now.mean < lowest_mean - GP_BALANCE_QUALITY_TOL)
+        *slot = lowest_mean;
+        if (lower_max || lower_mean)
             stall = 0;
         else if (++stall >= GP_BALANCE_STALL_SWEEPS) {
             out->stop = GP_BALANCE_STOP_STALLED;
             break;
         }
-        lowest_max = now.max < lowest_max ? now.max : lowest_max;
-        lowest_mean = now.mean < lowest_mean ? now.mean : lowest_mean;
     }
     restore_best(b);
     if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, progress, &out->after, err)))

@@ -198,7 +198,8 @@ static void test_both_methods_keep_every_promise_on_the_reference_cases(void)
                               s.before_mean, s.after_mean);
                 unchanged += s.best_sweep == 0;
                 /* a thousand grains or a few are never steady: the stall rule ends their
-                 * relocation (GP_BALANCE_STEADY_RTOL), and Laplacian smoothing converges */
+                 * relocation (GP_BALANCE_STEADY_MIN_INTERIOR), and Laplacian smoothing
+                 * converges */
                 if (c < 3)
                     CHECK_MSG(s.stop != GP_BALANCE_STOP_STEADY, "%s %s seed %d stopped steady", cases[c],
                               gp_balance_method_name((gp_balance_method)m), seed);
@@ -230,20 +231,18 @@ static void test_relocation_beats_the_report_on_the_fixed_case(void)
     gp_spec_free(&spec);
 }
 
-static void test_relocation_of_a_large_structure_ends_before_the_cap(void)
+static void test_relocation_of_a_large_structure_ends_steady(void)
 {
-    /* the variable law on 10^5 grains: the sweeps end by the steady rule or the stall
-     * rule, well before the cap, and return the best structure they saw. The steady stop
-     * ended this case after 12 sweeps on the packer before the densest default; on
-     * today's packings (either rule) the mean F still moves by more than the steady
-     * tolerance and the stall rule ends it (22-26 sweeps, seed 1): issue 12, item 4 */
+    /* the variable law on 10^5 grains: F_max is held after the first sweep and the mean
+     * F, lowest after the second, creeps up while it swings from sweep to sweep; the
+     * steady rule ends the sweeps GP_BALANCE_STEADY_SWEEPS after the last progress (8
+     * sweeps, seed 1, where the stall rule ran 22) with the best structure seen */
     gp_spec spec;
     load_example("variable", &spec);
     spec.domain = (gp_domain){50.0 * sqrt(1e5 / 1260.0), 50.0 * sqrt(1e5 / 1260.0)};
     summary s = check_balance(&spec, 1, GP_BALANCE_RELOCATION, "variable 10^5");
-    CHECK_MSG((s.stop == GP_BALANCE_STOP_STEADY || s.stop == GP_BALANCE_STOP_STALLED) &&
-                  s.sweeps <= s.best_sweep + GP_BALANCE_STALL_SWEEPS &&
-                  s.sweeps < GP_BALANCE_DEFAULT_MAX_ITERATIONS,
+    CHECK_MSG(s.stop == GP_BALANCE_STOP_STEADY && s.sweeps < GP_BALANCE_STALL_SWEEPS &&
+                  s.sweeps >= s.best_sweep + GP_BALANCE_STEADY_SWEEPS,
               "stopped %s after %u sweeps, best %u", gp_balance_stop_name(s.stop), s.sweeps, s.best_sweep);
     CHECK(s.after_max < s.before_max && s.after_mean < s.before_mean);
     gp_spec_free(&spec);
@@ -368,7 +367,7 @@ int main(void)
     RUN(test_wall_layer_has_no_F);
     RUN(test_method_none_measures_without_moving);
     RUN(test_relocation_beats_the_report_on_the_fixed_case);
-    RUN(test_relocation_of_a_large_structure_ends_before_the_cap);
+    RUN(test_relocation_of_a_large_structure_ends_steady);
     RUN(test_progress_rises_to_one_and_cancel_stops);
     RUN(test_flips_and_rebuilds_give_the_same_structure);
     RUN(test_both_methods_keep_every_promise_on_the_reference_cases);

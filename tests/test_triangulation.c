@@ -450,8 +450,8 @@ static void test_a_raised_flag_stops_builds_updates_and_measures(void)
     CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     CHECK(gp_rt_update_moved(rt, d, n, ids, 1, GP_RT_UPDATE_REBUILD, NULL, &canceled, &err) == GP_ECANCELED);
     gp_rt_free(rt);
-    /* the walk of all the rings (10^4 vertices: a check every GP_RT_RINGS_PER_CHECK of
-     * its 2 * 10^4 steps) stops too, and hands back no array */
+    /* the walk of all the rings (10^4 vertices, fewer than GP_RT_RINGS_PER_CHECK: the
+     * check after the walk) stops too, and hands back no array */
     CHECK(gp_rt_build(d, n, NULL, &rt, &err) == 0);
     size_t *start = malloc((n + 1) * sizeof *start);
     int32_t *rings = (int32_t *)&raised; /* must come back NULL */

@@ -74,13 +74,13 @@ GP_API size_t gp_rt_ring(const gp_rt *rt, int32_t id, int32_t *out, size_t cap,
 
 /* Every ring at once, each as gp_rt_ring gives it: vertex id's ring is
  * (*ids)[start[id]] .. (*ids)[start[id + 1] - 1] and hull[id] is its on_hull. The
- * triangulation is walked in its own memory order, where a vertex and its faces lie
+ * triangulation is walked once, in its own memory order, where a vertex and its faces lie
  * together; asking gp_rt_ring for each id in turn jumps across the whole structure for
  * every ring (at 10^6 grains that walk was half of the Laguerre cells' time). `start`
  * (gp_rt_count + 1 entries) and `hull` (gp_rt_count, or NULL when not wanted) are the
  * caller's; *ids is allocated here and the caller frees it. Returns 0, GP_ENOMEM or
- * GP_ECANCELED (progress->cancel is read every GP_RT_RINGS_PER_CHECK vertices of each of
- * the two walks; no progress is reported; `progress` may be NULL); *ids is then NULL. */
+ * GP_ECANCELED (progress->cancel is read every GP_RT_RINGS_PER_CHECK vertices of the walk
+ * and once after it; no progress is reported; `progress` may be NULL); *ids is then NULL. */
 GP_API int gp_rt_rings(const gp_rt *rt, size_t *start, uint8_t *hull, int32_t **ids,
                        const gp_progress *progress) GP_RT_NOEXCEPT;
 
