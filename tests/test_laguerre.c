@@ -497,7 +497,7 @@ static void test_vtk_and_json_carry_every_cell(void)
 
 static void test_a_disk_outside_its_cell_is_a_geometry_error(void)
 {
-    gp_domain dom = {10, 10};
+    gp_domain dom = {10, 10, 0};
     gp_disk out_of_domain[3] = {{2, 2, 0.9, 1}, {5, 5, 0.9, 1}, {11, 5, 0.9, 1}};
     /* the small disk's centre is inside the big one: its power cell lies beyond it */
     gp_disk overlapping[3] = {{2, 2, 1.8, 2}, {3.5, 2, 0.9, 1}, {7, 7, 0.9, 1}};
@@ -516,7 +516,7 @@ static void test_a_disk_outside_its_cell_is_a_geometry_error(void)
 
 static void test_one_disk_owns_the_whole_domain(void)
 {
-    gp_domain dom = {4, 3};
+    gp_domain dom = {4, 3, 0};
     gp_disk one = {1, 1, 0.5, 0.8};
     gp_rt *rt;
     gp_error err;
