@@ -735,8 +735,8 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
         return GP_EINVAL;
     }
     /* the stages that do not take a periodic domain yet (docs/method.md §3.8) */
-    static const char *const walled_only[] = {"balance", "laguerre", "mesh"};
-    int enabled[] = {spec->balance_enabled, spec->laguerre_enabled, spec->mesh_enabled};
+    static const char *const walled_only[] = {"balance", "mesh"};
+    int enabled[] = {spec->balance_enabled, spec->mesh_enabled};
     for (size_t k = 0; k < sizeof enabled / sizeof enabled[0]; k++)
         if (spec->domain.periodic && enabled[k]) {
             char stage_ptr[GP_ERROR_POINTER_MAX];

@@ -191,8 +191,11 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", stages[i].stage);
         CHECK_STR(err.pointer, stages[i].pointer);
     }
-    /* along a walled axis the short side is the walled rule's: one disk must fit */
+    /* the cells do take it (test_laguerre checks them) */
     gp_error err;
+    CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW
+                      ", \"laguerre\": {\"shrink\": \"offset\"}}", &err) == 0);
+    /* along a walled axis the short side is the walled rule's: one disk must fit */
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 2.5, \"periodic\": [\"x\"]}, " LAW "}",
                       &err) == 0);
 }
