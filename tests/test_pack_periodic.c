@@ -5,11 +5,15 @@
  * bin within 4 standard errors, and the front closes; the spec field and its errors. */
 #include <stdlib.h>
 
+#include <jansson.h>
+
 #include "check.h"
 #include "grainpack/pack.h"
+#include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
 #include "grainpack/stats.h"
 #include "packing_checks.h"
+#include "render_checks.h"
 
 /* Bins must stay within this many standard errors of their target (as in
  * test_pack_properties: |z| > 4 has probability 6e-5 per bin). */
@@ -212,8 +216,56 @@ static void test_narrow_periodic_strip_fills(void)
     gp_spec_free(&spec);
 }
 
+static void test_outputs_say_periodic_and_keep_centres_inside(void)
+{
+    /* the JSON gives the domain as the spec did and its statistics say periodic; the CSV's
+     * centres are all inside the domain (disks across a side are written once) */
+    static const char *const domains[] = {"true", "[\"y\"]"};
+    static const char *const axes[] = {"[\"x\",\"y\"]", "[\"y\"]"}; /* compact */
+    for (size_t k = 0; k < 2; k++) {
+        char json[512];
+        snprintf(json, sizeof json,
+                 "{\"domain\": {\"width\": 24, \"height\": 30, \"periodic\": %s}, " LAW
+                 ", \"laguerre\": {\"shrink\": \"offset\"}}",
+                 domains[k]);
+        gp_spec spec;
+        gp_error err;
+        CHECK(gp_spec_parse(json, strlen(json), NULL, &spec, &err) == 0);
+        gp_result result;
+        CHECK(gp_pipeline_run(&spec, 0, NULL, &result, &err) == 0);
+        char *text = render_text(GP_FORMAT_JSON, &spec, &result, NULL);
+        json_error_t jerr;
+        json_t *root = json_loads(text, 0, &jerr);
+        CHECK(root != NULL);
+        char *domain = json_dumps(json_object_get(json_object_get(root, "domain"), "periodic"), JSON_COMPACT);
+        char *stats = json_dumps(json_object_get(json_object_get(root, "statistics"), "periodic"), JSON_COMPACT);
+        const char *want = axes[k];
+        CHECK_MSG(domain && strcmp(domain, want) == 0, "domain.periodic %s, want %s", domain, want);
+        CHECK_MSG(stats && strcmp(stats, want) == 0, "statistics.periodic %s, want %s", stats, want);
+        free(domain);
+        free(stats);
+        json_decref(root);
+        free(text);
+        text = render_text(GP_FORMAT_CSV, &spec, &result, NULL);
+        size_t rows = 0, outside = 0;
+        for (char *line = strchr(text, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+            double x, y;
+            if (sscanf(line + 1, "%lf,%lf", &x, &y) != 2)
+                continue;
+            rows++;
+            outside += !(x >= 0.0 && x < spec.domain.width && y >= 0.0 && y < spec.domain.height);
+        }
+        CHECK(rows == result.packing.count);
+        CHECK_MSG(outside == 0, "%zu CSV centres outside", outside);
+        free(text);
+        gp_result_free(&result);
+        gp_spec_free(&spec);
+    }
+}
+
 int main(void)
 {
+    RUN(test_outputs_say_periodic_and_keep_centres_inside);
     RUN(test_spec_field_and_its_errors);
     RUN(test_narrow_periodic_strip_fills);
     RUN(test_periodic_packings_hold_every_property);
