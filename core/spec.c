@@ -587,12 +587,22 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
     char ptr[GP_ERROR_POINTER_MAX], color_ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
     spec->picture_color = spec->balance_enabled ? GP_PICTURE_COLOR_QUALITY : GP_PICTURE_COLOR_RADIUS;
+    spec->picture_tile = 1;
     int rc = get_object(v, inputs, base, "picture", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
-    static const char *const members[] = {"color", "disks", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "color, disks")))
+    static const char *const members[] = {"color", "disks", "tile", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "color, disks, tile")))
         return rc;
+    if ((rc = get_integer(v, obj, ptr, "tile", 1, GP_PICTURE_MAX_TILE, &spec->picture_tile)))
+        return rc;
+    if (spec->picture_tile > 1 && !spec->domain.periodic) {
+        char tile_ptr[GP_ERROR_POINTER_MAX];
+        pointer_key(tile_ptr, ptr, "tile");
+        return gp_error_set(v->err, GP_EINVAL, tile_ptr,
+                            "tiles a periodic domain only; add \"periodic\" to the domain or leave "
+                            "\"tile\" out");
+    }
     if (json_object_get(obj, "color")) {
         static const char *const colors[] = {"radius", "quality", NULL};
         int color;

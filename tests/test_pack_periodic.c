@@ -195,6 +195,20 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", stages[i].stage);
         CHECK_STR(err.pointer, stages[i].pointer);
     }
+    /* a tiled picture needs a periodic domain, and at most GP_PICTURE_MAX_TILE copies */
+    static const struct {
+        const char *domain, *tile;
+    } tiles[] = {{"{\"width\": 30, \"height\": 30}", "2"},
+                 {"{\"width\": 30, \"height\": 30, \"periodic\": true}", "5"},
+                 {"{\"width\": 30, \"height\": 30, \"periodic\": true}", "1.5"}};
+    for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
+        char json[512];
+        snprintf(json, sizeof json, "{\"domain\": %s, " LAW ", \"picture\": {\"tile\": %s}}",
+                 tiles[i].domain, tiles[i].tile);
+        gp_error err;
+        CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", json);
+        CHECK_STR(err.pointer, "/picture/tile");
+    }
     /* the cells do take it (test_laguerre checks them) */
     gp_error err;
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW
@@ -257,6 +271,24 @@ static void test_outputs_say_periodic_and_keep_centres_inside(void)
         }
         CHECK(rows == result.packing.count);
         CHECK_MSG(outside == 0, "%zu CSV centres outside", outside);
+        free(text);
+        /* the SVG draws the grains once and uses them at every copy that reaches the
+         * picture: (1 + 2) x (1 + 2) on the torus, 1 x 3 on the strip periodic along y */
+        text = render_text(GP_FORMAT_SVG, &spec, &result, NULL);
+        size_t uses = 0;
+        for (const char *p = strstr(text, "<use "); p; p = strstr(p + 1, "<use "))
+            uses++;
+        CHECK_MSG(uses == (k == 0 ? 9u : 3u), "%zu copies drawn", uses);
+        CHECK(strstr(text, "<clipPath id=\"gp-domain\"><rect x=\"0\" y=\"0\" width=\"24\" height=\"30\"/>") != NULL);
+        free(text);
+        /* a 2x2 tiling: the picture twice as wide and high, (2 + 2) x (2 + 2) copies */
+        spec.picture_tile = 2;
+        text = render_text(GP_FORMAT_SVG, &spec, &result, NULL);
+        uses = 0;
+        for (const char *p = strstr(text, "<use "); p; p = strstr(p + 1, "<use "))
+            uses++;
+        CHECK_MSG(uses == (k == 0 ? 16u : 4u), "%zu copies drawn for tile 2", uses);
+        CHECK(strstr(text, k == 0 ? "width=\"48\" height=\"60\"/>" : "width=\"24\" height=\"60\"/>") != NULL);
         free(text);
         gp_result_free(&result);
         gp_spec_free(&spec);
