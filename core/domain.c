@@ -28,6 +28,14 @@ static double wrap_axis(double t, double period)
     return t < period ? t : 0.0;
 }
 
+void gp_domain_min_image(const gp_domain *domain, double *dx, double *dy)
+{
+    if (domain->periodic & GP_PERIODIC_X)
+        *dx -= domain->width * nearbyint(*dx / domain->width);
+    if (domain->periodic & GP_PERIODIC_Y)
+        *dy -= domain->height * nearbyint(*dy / domain->height);
+}
+
 void gp_domain_wrap(const gp_domain *domain, double *x, double *y)
 {
     if (domain->periodic & GP_PERIODIC_X)

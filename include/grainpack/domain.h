@@ -4,8 +4,6 @@
 #ifndef GRAINPACK_DOMAIN_H
 #define GRAINPACK_DOMAIN_H
 
-#include <math.h>
-
 #include "grainpack/api.h"
 
 #ifdef __cplusplus
@@ -44,13 +42,7 @@ static inline int gp_domain_contains_disk(const gp_domain *domain, double x, dou
 
 /* Turns the vector (*dx, *dy) between two points into the shortest one between their
  * periodic images (the minimum-image convention); unchanged along walled axes. */
-static inline void gp_domain_min_image(const gp_domain *domain, double *dx, double *dy)
-{
-    if (domain->periodic & GP_PERIODIC_X)
-        *dx -= domain->width * nearbyint(*dx / domain->width);
-    if (domain->periodic & GP_PERIODIC_Y)
-        *dy -= domain->height * nearbyint(*dy / domain->height);
-}
+GP_API void gp_domain_min_image(const gp_domain *domain, double *dx, double *dy);
 
 /* Brings (*x, *y) into [0, W) x [0, H) along the periodic axes (the image of the point
  * that lies in the domain); unchanged along walled axes. */
