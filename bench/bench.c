@@ -314,7 +314,7 @@ static void scale_point(double target, int default_rule, uint32_t band)
          * the report's: pick the square whose area holds `target` disks */
         double fill = default_rule ? 0.87 : 0.79;
         double side = sqrt(target * M_PI * gp_distribution_mean_packing_r2(&dist, &joint) / fill);
-        gp_domain dom = {side, side};
+        gp_domain dom = {side, side, 0};
         gp_pack_params params = {.domain = &dom, .dist = &dist, .joint = &joint, .seed = 1,
                                  .level_band = band,
                                  .rule = default_rule ? GP_FRONT_DEFAULT : GP_FRONT_LEVEL_BAND};
@@ -375,7 +375,7 @@ static void two_bins_init(two_bins *tb, double r_small, double r_large, double p
     tb->bins[0] = (gp_bin){r_small, 1.05 * r_small, p_small};
     tb->bins[1] = (gp_bin){r_large / 1.05, r_large, 1.0 - p_small};
     tb->dist = (gp_distribution){.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = tb->bins};
-    tb->dom = (gp_domain){side, side};
+    tb->dom = (gp_domain){side, side, 0};
     if (gp_distribution_prepare(&tb->dist))
         exit(1);
 }

@@ -147,7 +147,7 @@ static void scaled_variable(const char *dir, double grains, gp_spec *spec)
     load(dir, "variable", spec);
     /* the report's 50 x 50 holds about 1260 grains */
     double side = 50.0 * sqrt(grains / 1260.0);
-    spec->domain = (gp_domain){side, side};
+    spec->domain = (gp_domain){side, side, 0};
 }
 
 /* Runs `work` in a child process and reports its peak resident memory growth. */

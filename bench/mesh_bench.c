@@ -332,7 +332,7 @@ int main(int argc, char **argv)
     if (only ? strcmp(only, "large") == 0 : !quick) {
         /* the fixed case scaled to 10^5 grains: it holds about 2,790 in 100 x 100 */
         double side = 100.0 * sqrt(1e5 / 2790.0);
-        spec.domain = (gp_domain){side, side};
+        spec.domain = (gp_domain){side, side, 0};
         /* Gmsh once, at the size ratio the fixed case found (the same grains, scaled) */
         bench_case("fixed, 10^5 grains", &spec, gmsh && gmsh_large, tmp, &cl_ratio, 1);
     }

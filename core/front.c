@@ -13,6 +13,15 @@
  * GP_CONTACT_RTOL, with room for the rounding of a placement. */
 #define TOUCH_RTOL 1e-7
 
+/* The vector from disk a to disk b: to b's image nearest a on a periodic domain. */
+static void disk_vector(const front *f, const gp_disk *da, const gp_disk *db, double *dx,
+                        double *dy)
+{
+    *dx = db->x - da->x;
+    *dy = db->y - da->y;
+    gp_domain_min_image(f->grid->domain, dx, dy);
+}
+
 int front_init(front *f, const gp_disk *const *disks, const uint32_t *const *levels,
                const gp_grid *grid, size_t disk_capacity, double R_lo, double R_hi)
 {
@@ -39,6 +48,7 @@ void front_free(front *f)
     free(f->first_node);
     free(f->barrier_head);
     free(f->links);
+    free(f->winding);
     memset(f, 0, sizeof *f);
 }
 
@@ -234,7 +244,8 @@ static int uncovered_part(const front *f, int32_t u, double *px, double *py, dou
 {
     const gp_disk *da = &(*f->disks)[f->nodes[u].disk];
     const gp_disk *db = &(*f->disks)[f->nodes[f->nodes[u].next].disk];
-    double ux = db->x - da->x, uy = db->y - da->y;
+    double ux, uy;
+    disk_vector(f, da, db, &ux, &uy);
     double d = sqrt(ux * ux + uy * uy);
     if (!(d - da->R - db->R > TOUCH_RTOL * (da->R + db->R)))
         return 0;
@@ -242,8 +253,11 @@ static int uncovered_part(const front *f, int32_t u, double *px, double *py, dou
     uy /= d;
     *px = da->x + da->R * ux;
     *py = da->y + da->R * uy;
-    *qx = db->x - db->R * ux;
-    *qy = db->y - db->R * uy;
+    /* b itself, or on a periodic domain its image nearest a */
+    double bx = f->grid->domain->periodic ? da->x + d * ux : db->x;
+    double by = f->grid->domain->periodic ? da->y + d * uy : db->y;
+    *qx = bx - db->R * ux;
+    *qy = by - db->R * uy;
     return 1;
 }
 
@@ -252,15 +266,36 @@ static int uncovered_part(const front *f, int32_t u, double *px, double *py, dou
  * the part's bounding box grown by R_max. The part is shorter than a cell side (a closing
  * joins disks that both met one candidate disk, and the initial front stops where the
  * next disk would not fit), so that is at most 3x3 cells and usually 2x2; a query then
- * reads its own cell's list only. */
+ * reads its own cell's list only. Along a periodic axis the range is in unwrapped cell
+ * numbers (it may run past either side), read through gp_grid_index_wrapped, and holds
+ * at most one period of cells so that none is registered twice. */
 static void barrier_cells(const front *f, const double *part, int32_t range[4])
 {
     const gp_grid *g = f->grid;
     double reach = 0.5 * g->cell;
     double lo_x = fmin(part[0], part[2]) - reach, hi_x = fmax(part[0], part[2]) + reach;
     double lo_y = fmin(part[1], part[3]) - reach, hi_y = fmax(part[1], part[3]) + reach;
-    gp_grid_coords(g, lo_x, lo_y, &range[0], &range[1]);
-    gp_grid_coords(g, hi_x, hi_y, &range[2], &range[3]);
+    unsigned periodic = g->domain->periodic;
+    if (!periodic) {
+        gp_grid_coords(g, lo_x, lo_y, &range[0], &range[1]);
+        gp_grid_coords(g, hi_x, hi_y, &range[2], &range[3]);
+        return;
+    }
+    /* the part starts within R_max of a centre inside the domain and is under 4 R_max
+     * long: its box reaches under three cells past the domain, within one period */
+    double lo[2] = {lo_x, lo_y}, hi[2] = {hi_x, hi_y}, inv[2] = {g->inv_cell_x, g->inv_cell_y};
+    int32_t n[2] = {g->nx, g->ny};
+    for (int a = 0; a < 2; a++) {
+        int32_t first = (int32_t)floor(lo[a] * inv[a]), last = (int32_t)floor(hi[a] * inv[a]);
+        if (!(periodic & (a ? GP_PERIODIC_Y : GP_PERIODIC_X))) {
+            first = first < 0 ? 0 : (first >= n[a] ? n[a] - 1 : first);
+            last = last < 0 ? 0 : (last >= n[a] ? n[a] - 1 : last);
+        } else if (last - first >= n[a]) {
+            last = first + n[a] - 1;
+        }
+        range[a] = first;
+        range[a + 2] = last;
+    }
 }
 
 /* Whether a disk of radius R (the smallest the law draws) can reach the segment between
@@ -302,7 +337,7 @@ static int register_barrier(front *f, int32_t u)
             } else {
                 f->free_link = f->links[link].next;
             }
-            size_t cell = gp_grid_index(f->grid, cx, cy);
+            size_t cell = gp_grid_index_wrapped(f->grid, cx, cy);
             f->links[link] = (front_link){u, f->barrier_head[cell]};
             f->barrier_head[cell] = link;
         }
@@ -320,7 +355,7 @@ static void unregister_barrier(front *f, int32_t u)
     barrier_cells(f, n->gap, range);
     for (int32_t cy = range[1]; cy <= range[3]; cy++) {
         for (int32_t cx = range[0]; cx <= range[2]; cx++) {
-            int32_t *link = &f->barrier_head[gp_grid_index(f->grid, cx, cy)];
+            int32_t *link = &f->barrier_head[gp_grid_index_wrapped(f->grid, cx, cy)];
             while (f->links[*link].node != u)
                 link = &f->links[*link].next;
             int32_t gone = *link;
@@ -350,7 +385,15 @@ int32_t front_barrier_crossed(const front *f, double x, double y, double R, int3
          link = f->links[link].next) {
         int32_t u = f->links[link].node;
         const double *part = f->nodes[u].gap;
-        if (u != skip && dist2_to_segment(x, y, part[0], part[1], part[2], part[3]) < reach * reach)
+        double px = x, py = y;
+        if (f->grid->domain->periodic) {
+            /* the candidate's image nearest the part's start */
+            double dx = x - part[0], dy = y - part[1];
+            gp_domain_min_image(f->grid->domain, &dx, &dy);
+            px = part[0] + dx;
+            py = part[1] + dy;
+        }
+        if (u != skip && dist2_to_segment(px, py, part[0], part[1], part[2], part[3]) < reach * reach)
             return u;
     }
     return FRONT_NONE;
@@ -365,7 +408,8 @@ static int attach_segment(front *f, int32_t u, int touching)
 {
     front_node *n = &f->nodes[u];
     const gp_disk *da = &(*f->disks)[n->disk], *db = &(*f->disks)[f->nodes[n->next].disk];
-    double dx = db->x - da->x, dy = db->y - da->y;
+    double dx, dy;
+    disk_vector(f, da, db, &dx, &dy);
     /* touching disks are R_a + R_b apart up to rounding; no need for the square root */
     n->length = touching ? da->R + db->R : sqrt(dx * dx + dy * dy);
     n->ux = n->length > 0.0 ? dx / n->length : 0.0;
@@ -448,9 +492,65 @@ static void drop_if_degenerate(front *f, int32_t u)
     }
 }
 
+/* ---- loop labels, and on a periodic domain their windings ---- */
+
+static int periodic(const front *f)
+{
+    return f->grid->domain->periodic != 0;
+}
+
+/* A fresh loop label in *label (with room for its winding on a periodic domain): 0 or
+ * GP_ENOMEM. */
+static int new_label(front *f, uint32_t *label)
+{
+    uint32_t l = f->next_loop;
+    if (periodic(f)) {
+        int32_t *grown = grow(f->winding, &f->winding_capacity, (size_t)l + 1, 2 * sizeof *grown);
+        if (!grown)
+            return GP_ENOMEM;
+        f->winding = grown;
+        f->winding[2 * l] = f->winding[2 * l + 1] = 0;
+    }
+    f->next_loop++;
+    *label = l;
+    return 0;
+}
+
+/* Gives every node of the loop through `start` the label `loop` and, on a periodic
+ * domain, sets that label's winding from the loop's segments: the sum of the vectors
+ * between nearest images is a whole number of periods along each axis (0 for a loop
+ * that does not wind around the torus). */
+static void label_loop(front *f, int32_t start, uint32_t loop)
+{
+    double sx = 0.0, sy = 0.0;
+    int32_t u = start;
+    do {
+        f->nodes[u].loop = loop;
+        if (periodic(f)) {
+            double dx, dy;
+            disk_vector(f, &(*f->disks)[f->nodes[u].disk],
+                        &(*f->disks)[f->nodes[f->nodes[u].next].disk], &dx, &dy);
+            sx += dx;
+            sy += dy;
+        }
+        u = f->nodes[u].next;
+    } while (u != start);
+    if (periodic(f)) {
+        f->winding[2 * loop] = (int32_t)lround(sx / f->grid->domain->width);
+        f->winding[2 * loop + 1] = (int32_t)lround(sy / f->grid->domain->height);
+    }
+}
+
+static int winds(const front *f, uint32_t loop)
+{
+    return f->winding[2 * loop] != 0 || f->winding[2 * loop + 1] != 0;
+}
+
 int front_add_loop(front *f, const int32_t *disks, size_t n)
 {
-    uint32_t loop = f->next_loop++;
+    uint32_t loop;
+    if (new_label(f, &loop))
+        return GP_ENOMEM;
     int32_t first = FRONT_NONE, prev = FRONT_NONE;
     for (size_t i = 0; i < n; i++) {
         int32_t u = new_node(f, disks[i], loop);
@@ -465,6 +565,7 @@ int front_add_loop(front *f, const int32_t *disks, size_t n)
     }
     f->nodes[prev].next = first;
     f->nodes[first].prev = prev;
+    label_loop(f, first, loop);
     for (int32_t u = first;;) {
         if (attach_segment(f, u, 0))
             return GP_ENOMEM;
@@ -500,22 +601,38 @@ int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u)
     return FRONT_NONE;
 }
 
-/* After a split, gives the shorter of the loops through a and b a new label, walking both
- * at the same pace so that the cost is that of the shorter one. */
-static void relabel_shorter(front *f, int32_t a, int32_t b)
+int32_t front_node_on_winding_loop(const front *f, int32_t disk, int32_t u)
 {
+    uint32_t loop = f->nodes[u].loop;
+    if (!periodic(f) || !winds(f, loop))
+        return FRONT_NONE;
+    for (int32_t w = f->first_node[disk]; w != FRONT_NONE; w = f->nodes[w].next_of_disk)
+        if (f->nodes[w].loop != loop && winds(f, f->nodes[w].loop))
+            return w;
+    return FRONT_NONE;
+}
+
+/* After a split, gives the shorter of the loops through a and b a new label, walking both
+ * at the same pace so that the cost is that of the shorter one; the longer keeps the old
+ * label, and its winding is what the shorter's leaves of the old loop's. */
+static int relabel_shorter(front *f, int32_t a, int32_t b)
+{
+    uint32_t old = f->nodes[a].loop;
     int32_t x = f->nodes[a].next, y = f->nodes[b].next;
     while (x != a && y != b) {
         x = f->nodes[x].next;
         y = f->nodes[y].next;
     }
     int32_t start = x == a ? a : b;
-    uint32_t loop = f->next_loop++;
-    int32_t u = start;
-    do {
-        f->nodes[u].loop = loop;
-        u = f->nodes[u].next;
-    } while (u != start);
+    uint32_t loop;
+    if (new_label(f, &loop))
+        return GP_ENOMEM;
+    label_loop(f, start, loop);
+    if (periodic(f)) {
+        f->winding[2 * old] -= f->winding[2 * loop];
+        f->winding[2 * old + 1] -= f->winding[2 * loop + 1];
+    }
+    return 0;
 }
 
 /* Takes node `middle` off its loop: `before` (its predecessor) links to what followed
@@ -537,6 +654,7 @@ static int cut_ear(front *f, int32_t before, int32_t middle)
 int front_close(front *f, int32_t u, int32_t w)
 {
     int32_t v = f->nodes[u].next;
+    int merge = f->nodes[w].loop != f->nodes[u].loop;
     if (w == f->nodes[v].next)
         return cut_ear(f, u, v); /* pk follows p2: p2 leaves the loop */
     if (w == f->nodes[u].prev)
@@ -555,7 +673,17 @@ int front_close(front *f, int32_t u, int32_t w)
     f->nodes[w].prev = u;
     if (attach_segment(f, u, 0) || attach_segment(f, w2, 0))
         return GP_ENOMEM;
-    relabel_shorter(f, u, w2);
+    if (merge) {
+        /* two winding loops made one: it gets a label of its own (a walk of the whole loop,
+         * once per pair of winding loops, so a few times per packing) */
+        uint32_t loop;
+        if (new_label(f, &loop))
+            return GP_ENOMEM;
+        label_loop(f, u, loop);
+        return 0;
+    }
+    if (relabel_shorter(f, u, w2))
+        return GP_ENOMEM;
     drop_if_degenerate(f, u);
     drop_if_degenerate(f, w2);
     return 0;

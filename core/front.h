@@ -13,7 +13,12 @@
  *
  * A segment whose disks do not touch spans a void. Such a "barrier" is registered in the
  * bucket grid so that no later disk is placed across it into the filled side; with it,
- * the loops stay simple and every closing cuts a triangle off the empty region. */
+ * the loops stay simple and every closing cuts a triangle off the empty region.
+ *
+ * On a periodic domain (docs/method.md §3.8) segments join nearest images, and a loop may
+ * wind around the torus: its winding (the sum of its segments, in periods) is kept per
+ * loop, because two winding loops can bound the same empty region, and closing one on
+ * the other merges them. */
 #ifndef GRAINPACK_CORE_FRONT_H
 #define GRAINPACK_CORE_FRONT_H
 
@@ -86,6 +91,8 @@ typedef struct front {
     front_link *links;
     size_t nlinks, link_capacity;
     int32_t free_link;
+    int32_t *winding;             /* periodic domains: per loop label, periods along x, y */
+    size_t winding_capacity;      /* labels with room in winding */
 } front;
 
 /* Sets up an empty front over `grid`, with per-disk room for `disk_capacity` disks, for
@@ -126,10 +133,17 @@ int front_place(front *f, int32_t u, int32_t c, int c_touches_b);
 /* The node of `disk` on the same loop as node u, or FRONT_NONE. */
 int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u);
 
+/* On a periodic domain, when node u's loop winds around the domain: a node of `disk` on
+ * another loop that winds too (the two then bound the same empty band, see front.c), or
+ * FRONT_NONE. */
+int32_t front_node_on_winding_loop(const front *f, int32_t disk, int32_t u);
+
 /* Closes the front at node u's segment (p1, p2) on node w of the same loop (docs/method.md §3.5):
  * the segment is replaced by p1 -> pk -> p2, which cuts an ear off the loop when pk is
  * next to p1 or p2, and splits the loop in two otherwise. Loops left with fewer than
- * three nodes enclose nothing and go. Returns 0 or GP_ENOMEM. */
+ * three nodes enclose nothing and go. On a periodic domain w may be on another winding
+ * loop (front_node_on_winding_loop): the same replacement then merges the two loops into
+ * one. Returns 0 or GP_ENOMEM. */
 int front_close(front *f, int32_t u, int32_t w);
 
 /* Takes node u's segment out of the work; it still bounds its loop. */

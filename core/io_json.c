@@ -149,6 +149,18 @@ static json_t *cells_json(const gp_spec *spec, const gp_cell_stats *c, int *fail
     return o;
 }
 
+/* The periodic axes, as the spec's list form: ["x"], ["y"] or ["x", "y"] (NULL if out of
+ * memory, which put reports). */
+static json_t *periodic_json(unsigned periodic)
+{
+    json_t *axes = json_array();
+    if (axes && (periodic & GP_PERIODIC_X))
+        json_array_append_new(axes, json_string("x"));
+    if (axes && (periodic & GP_PERIODIC_Y))
+        json_array_append_new(axes, json_string("y"));
+    return axes;
+}
+
 json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
 {
     const gp_pack_stats *st = &result->stats;
@@ -185,6 +197,8 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
     put(front, "max_level", json_integer((json_int_t)pk->max_level), &failed);
     put(root, "front", front, &failed);
     put(root, "seed", json_integer((json_int_t)spec->seed), &failed);
+    if (spec->domain.periodic)
+        put(root, "periodic", periodic_json(spec->domain.periodic), &failed);
     if (result->has_balance)
         put(root, "balance", balance_json(&result->balance, &failed), &failed);
     if (result->has_cells)
@@ -288,6 +302,11 @@ static void head(gp_writer *w, gp_out *out, int param)
     gp_out_double(out, w->spec->domain.width);
     GP_OUT_LITERAL(out, ", \"height\": ");
     gp_out_double(out, w->spec->domain.height);
+    unsigned periodic = w->spec->domain.periodic;
+    if (periodic) /* as the spec gives it; walled domains write nothing more */
+        gp_out_puts(out, periodic == GP_PERIODIC_X   ? ", \"periodic\": [\"x\"]"
+                         : periodic == GP_PERIODIC_Y ? ", \"periodic\": [\"y\"]"
+                                                     : ", \"periodic\": [\"x\", \"y\"]");
     GP_OUT_LITERAL(out, "},\n\"statistics\": ");
     gp_out_json(out, st->statistics);
     json_decref(st->statistics); /* written once: not needed any more */

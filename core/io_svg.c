@@ -4,7 +4,10 @@
  * with cells they are the (shrunk) cells on a dark grey ground, which is the boundary
  * band, optionally with the grain disks outlined. Kept compact for 10^5 grains: one
  * element per grain, grouped by colour class (one pass over the grains per class).
- * Coordinates are rounded to what a screen shows (see svg_decimals). */
+ * Coordinates are rounded to what a screen shows (see svg_decimals). On a periodic domain
+ * the grains are drawn once as a symbol and used at every copy of the domain that can
+ * reach the picture, clipped to it: the parts of a grain across a side show on the other
+ * side, and "picture": {"tile": k} draws k copies along each periodic axis. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -100,7 +103,9 @@ static rings ring_style(const gp_pack_stats *st)
 typedef struct svg_state {
     colouring c;
     rings rings;
-    double H; /* the domain's height: y is flipped (SVG's y points down) */
+    double H; /* the picture's height: y is flipped (SVG's y points down) */
+    double W; /* the picture's width: the domain's, times the copies along x */
+    int kx, ky; /* copies of the domain along x and y (1 on walls) */
     int dec;  /* decimals of coordinates */
 } svg_state;
 
@@ -202,11 +207,40 @@ static void outline(gp_writer *w, gp_out *out, const gp_grain_window *win, size_
 /* A rectangle over the domain, x = 0, y = 0, with what follows as its last attributes. */
 static void domain_rect(gp_writer *w, gp_out *out, const char *rest)
 {
+    svg_state *st = w->state;
     GP_OUT_LITERAL(out, "<rect x=\"0\" y=\"0\" width=\"");
-    gp_out_double(out, w->spec->domain.width);
+    gp_out_double(out, st->W);
     GP_OUT_LITERAL(out, "\" height=\"");
-    gp_out_double(out, w->spec->domain.height);
+    gp_out_double(out, st->H);
     gp_out_puts(out, rest);
+}
+
+/* Periodic domains: the grains that follow go into a symbol, not drawn by themselves. */
+static void tile_open(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    GP_OUT_LITERAL(out, "<defs>\n<clipPath id=\"gp-domain\">");
+    domain_rect(w, out, "\"/></clipPath>\n<g id=\"gp-tile\">\n");
+}
+
+/* Closes the symbol and draws it at every copy that reaches the picture: the k copies
+ * along each periodic axis and one more on either side, whose grains across a side
+ * show their parts inside. */
+static void tile_close(gp_writer *w, gp_out *out, int param)
+{
+    (void)param;
+    svg_state *st = w->state;
+    double W = w->spec->domain.width, H = w->spec->domain.height;
+    GP_OUT_LITERAL(out, "</g>\n</defs>\n<g clip-path=\"url(#gp-domain)\">\n");
+    int px = (w->spec->domain.periodic & GP_PERIODIC_X) != 0;
+    int py = (w->spec->domain.periodic & GP_PERIODIC_Y) != 0;
+    for (int i = px ? -1 : 0; i <= (px ? st->kx : 0); i++)
+        for (int j = py ? -1 : 0; j <= (py ? st->ky : 0); j++) {
+            attr(out, "<use href=\"#gp-tile\" x=\"", i * W, st->dec);
+            attr(out, " y=\"", -j * H, st->dec);
+            GP_OUT_LITERAL(out, "/>\n");
+        }
+    GP_OUT_LITERAL(out, "</g>\n");
 }
 
 static void head(gp_writer *w, gp_out *out, int param)
@@ -214,7 +248,7 @@ static void head(gp_writer *w, gp_out *out, int param)
     (void)param;
     svg_state *st = w->state;
     const gp_pack_stats *stats = &w->result->stats;
-    double W = w->spec->domain.width, H = w->spec->domain.height;
+    double W = st->W, H = st->H;
     double L = W > H ? W : H;
     int dec = st->dec;
     double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
@@ -235,9 +269,15 @@ static void head(gp_writer *w, gp_out *out, int param)
     GP_OUT_LITERAL(out, ">\n<title>grainpack: ");
     gp_out_uint(out, stats->count);
     GP_OUT_LITERAL(out, " grains in ");
-    gp_out_double(out, W);
+    gp_out_double(out, w->spec->domain.width);
     GP_OUT_LITERAL(out, " x ");
-    gp_out_double(out, H);
+    gp_out_double(out, w->spec->domain.height);
+    if (w->spec->domain.periodic)
+        gp_out_printf(out, ", periodic along %s, %d x %d copies",
+                      w->spec->domain.periodic == GP_PERIODIC_X   ? "x"
+                      : w->spec->domain.periodic == GP_PERIODIC_Y ? "y"
+                                                                  : "x and y",
+                      st->kx, st->ky);
     gp_out_printf(out, ", packing density %.4f</title>\n", stats->packing_density);
     attr(out, "<rect x=\"", -margin, st->dec);
     attr(out, " y=\"", -margin, st->dec);
@@ -266,7 +306,7 @@ static void legend(gp_writer *w, gp_out *out, int param)
     const colouring *c = &st->c;
     const gp_result *result = w->result;
     const gp_pack_stats *stats = &result->stats;
-    double W = w->spec->domain.width, H = w->spec->domain.height, L = W > H ? W : H;
+    double W = st->W, H = st->H, L = W > H ? W : H;
     double font = 0.022 * L, bar_h = 0.025 * L;
     int dec = st->dec;
     domain_rect(w, out, "\" fill=\"none\" stroke=\"" OUTLINE "\"");
@@ -335,10 +375,17 @@ int gp_plan_svg(gp_writer *w)
     w->state = st;
     st->c = choose_colouring(w->spec, w->result);
     st->rings = ring_style(&w->result->stats);
-    st->H = w->spec->domain.height;
+    unsigned periodic = w->spec->domain.periodic;
+    int tile = w->spec->picture_tile > 1 ? w->spec->picture_tile : 1;
+    st->kx = (periodic & GP_PERIODIC_X) ? tile : 1;
+    st->ky = (periodic & GP_PERIODIC_Y) ? tile : 1;
+    st->W = st->kx * w->spec->domain.width;
+    st->H = st->ky * w->spec->domain.height;
     st->dec = svg_decimals(w->spec);
     unsigned needs = GP_GRAINS_DISKS | (st->c.by_F ? GP_GRAINS_F : 0);
     gp_writer_text(w, head, 0);
+    if (periodic)
+        gp_writer_text(w, tile_open, 0);
     for (int cls = st->c.by_F ? NO_VALUE : 0; cls < COLOR_CLASSES; cls++) {
         gp_writer_text(w, open_group, cls);
         if (w->result->has_cells)
@@ -352,6 +399,8 @@ int gp_plan_svg(gp_writer *w)
         gp_writer_grains(w, outline, GP_GRAINS_DISKS, 0);
         gp_writer_text(w, close_group, 0);
     }
+    if (periodic)
+        gp_writer_text(w, tile_close, 0);
     if (w->result->has_mesh)
         gp_writer_text(w, mesh_edges, 0);
     gp_writer_text(w, legend, 0);

@@ -9,9 +9,17 @@
 #include <string.h>
 
 #include "grow.h"
+#include "periodic.h"
 
 /* Cells between two progress reports and cancel checks: a few milliseconds of work. */
 #define CELLS_PER_REPORT 16384
+/* The first ghost margin on a periodic domain, in largest packing radii: a cell of a
+ * dense packing reaches about one radius past its disk, so its vertices' power circles
+ * stay within a few radii; a margin too small is found out cell by cell (cell_complete)
+ * and doubled, up to a period. */
+#define GHOST_MARGIN_RADII 6.0
+/* build_cell's answer when a periodic cell may miss a neighbour beyond the ghosts. */
+#define CELL_INCOMPLETE 1
 
 /* Edge labels of a polygon under construction: the neighbour's index in the ring (>= 0)
  * or a wall. */
@@ -148,6 +156,11 @@ typedef struct builder {
     size_t hp_cap;
     gp_cells *out;
     size_t nxy, xy_cap, nnb, nb_cap; /* used and allocated entries of out->xy / neighbours */
+    /* periodic domains: disks[n..] are ghosts, copies of disks[origin[k - n]]; cells are
+     * cut from the domain grown by `margin` along the periodic axes */
+    const int32_t *origin;
+    size_t n;
+    double margin, R_max;
 } builder;
 
 /* The power cell of disk i clipped to the domain, into bd->a; its ring in bd->ring.
@@ -177,11 +190,24 @@ static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
         hp[k].c = radical(p, &bd->disks[bd->ring[k]], &hp[k].nx, &hp[k].ny, &hp[k].len);
     double W = bd->domain->width, H = bd->domain->height;
     bd->a.n = 0;
-    polygon_push(&bd->a, -p->x, -p->y, WALL_BOTTOM);
-    polygon_push(&bd->a, W - p->x, -p->y, WALL_RIGHT);
-    polygon_push(&bd->a, W - p->x, H - p->y, WALL_TOP);
-    polygon_push(&bd->a, -p->x, H - p->y, WALL_LEFT);
-    *holds_centre = p->x > 0.0 && p->y > 0.0 && p->x < W && p->y < H;
+    if (bd->origin) {
+        /* the ghosts' box along the periodic axes: a cell that reaches it is incomplete */
+        double gx = (bd->domain->periodic & GP_PERIODIC_X) ? bd->margin : 0.0;
+        double gy = (bd->domain->periodic & GP_PERIODIC_Y) ? bd->margin : 0.0;
+        polygon_push(&bd->a, -gx - p->x, -gy - p->y, WALL_BOTTOM);
+        polygon_push(&bd->a, W + gx - p->x, -gy - p->y, WALL_RIGHT);
+        polygon_push(&bd->a, W + gx - p->x, H + gy - p->y, WALL_TOP);
+        polygon_push(&bd->a, -gx - p->x, H + gy - p->y, WALL_LEFT);
+    } else {
+        polygon_push(&bd->a, -p->x, -p->y, WALL_BOTTOM);
+        polygon_push(&bd->a, W - p->x, -p->y, WALL_RIGHT);
+        polygon_push(&bd->a, W - p->x, H - p->y, WALL_TOP);
+        polygon_push(&bd->a, -p->x, H - p->y, WALL_LEFT);
+    }
+    /* inside the domain along its walled axes (a centre on a periodic side is inside) */
+    unsigned per = bd->origin ? bd->domain->periodic : 0;
+    *holds_centre = ((per & GP_PERIODIC_X) || (p->x > 0.0 && p->x < W)) &&
+                    ((per & GP_PERIODIC_Y) || (p->y > 0.0 && p->y < H));
     for (size_t k = 0; k < *degree && bd->a.n > 0; k++) {
         *holds_centre &= hp[k].c > 0.0;
         cut(&bd->a, hp[k].nx, hp[k].ny, hp[k].c, (int32_t)k, &bd->b);
@@ -190,6 +216,34 @@ static int power_cell(builder *bd, int32_t i, size_t *degree, int *holds_centre)
         bd->b = swap;
     }
     return 0;
+}
+
+/* Whether the power cell of disk p in bd->a (periodic domain) is its cell among all the
+ * periodic images: the cell from a subset of the sites contains the true one, and a site
+ * left out cuts it only if it is nearer in power than p to one of its vertices v, i.e.
+ * within sqrt(pow_p(v) + R_max^2) of v. When that disk around every vertex lies inside
+ * the ghosts' box along the periodic axes, no site left out can cut the cell (and no
+ * edge is the box's). */
+static int cell_complete(const builder *bd, const gp_disk *p)
+{
+    const gp_domain *dom = bd->domain;
+    for (size_t k = 0; k < bd->a.n; k++) {
+        double ux = bd->a.u[2 * k], uy = bd->a.u[2 * k + 1];
+        double pow_v = ux * ux + uy * uy - p->R * p->R;
+        double reach = sqrt((pow_v > 0.0 ? pow_v : 0.0) + bd->R_max * bd->R_max);
+        double x = p->x + ux, y = p->y + uy, m = bd->margin;
+        if ((dom->periodic & GP_PERIODIC_X) && !(x - reach > -m && x + reach < dom->width + m))
+            return 0;
+        if ((dom->periodic & GP_PERIODIC_Y) && !(y - reach > -m && y + reach < dom->height + m))
+            return 0;
+    }
+    return 1;
+}
+
+/* The grain a ring neighbour is: itself, or the disk a ghost copies. */
+static int32_t grain_of(const builder *bd, int32_t j)
+{
+    return bd->origin && (size_t)j >= bd->n ? bd->origin[(size_t)j - bd->n] : j;
 }
 
 /* Appends the neighbours across the edges of bd->a longer than the tolerance, which is
@@ -210,6 +264,7 @@ static int record_neighbours(builder *bd, int32_t i)
         double ex = a->u[2 * l] - a->u[2 * k], ey = a->u[2 * l + 1] - a->u[2 * k + 1];
         double len2 = ex * ex + ey * ey;
         double t = 0.5 * GP_LAGUERRE_EDGE_RTOL * (bd->disks[i].R + bd->disks[j].R), t2 = t * t;
+        j = grain_of(bd, j);
         if (len2 > t2)
             nb[bd->nnb++] = j;
         if (len2 >= 0.25 * t2 && len2 <= 4.0 * t2) {
@@ -273,6 +328,8 @@ static int build_cell(builder *bd, int32_t i, gp_error *err)
                             "disk %d at (%.17g, %.17g) is outside its own power cell: it overlaps "
                             "another disk or lies outside the domain",
                             i, p->x, p->y);
+    if (bd->origin && !cell_complete(bd, p))
+        return CELL_INCOMPLETE;
     bd->out->power_area_sum += gp_polygon_area(bd->a.u, bd->a.n);
     if (record_neighbours(bd, i))
         return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for neighbours");
@@ -330,9 +387,14 @@ static void symmetrize_neighbours(gp_cells *c, const int32_t *doubtful, size_t n
     c->nstart[c->count] = w;
 }
 
-int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
-                const gp_laguerre_params *params, const gp_progress *progress,
-                gp_cells *out, gp_error *err)
+/* The cells of disks[0..n-1] from rt, the triangulation of disks[0..nrt-1]: the disks
+ * themselves on a walled domain; on a periodic one the disks and their ghosts, copies of
+ * disks[origin[k - n]], within `margin` of the sides. Returns 0, CELL_INCOMPLETE (out
+ * zeroed) when the margin is too small for some cell, or a GP_E code with err set. */
+static int build_cells(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
+                       const int32_t *origin, double margin, double R_max,
+                       const gp_laguerre_params *params, const gp_progress *progress,
+                       gp_cells *out, gp_error *err)
 {
     memset(out, 0, sizeof *out);
     builder bd;
@@ -342,6 +404,10 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
     bd.params = params;
     bd.rt = rt;
     bd.out = out;
+    bd.origin = origin;
+    bd.n = n;
+    bd.margin = margin;
+    bd.R_max = R_max;
     out->count = n;
     out->shrink = params->shrink;
     out->start = calloc(n + 1, sizeof *out->start);
@@ -352,7 +418,7 @@ int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const g
     out->xy = malloc(bd.xy_cap * sizeof *out->xy);
     bd.nb_cap = 7 * n + 16;
     out->neighbours = malloc(bd.nb_cap * sizeof *out->neighbours);
-    bd.ring_start = malloc((n + 1) * sizeof *bd.ring_start);
+    bd.ring_start = malloc((gp_rt_count(rt) + 1) * sizeof *bd.ring_start);
     int rc = 0;
     if (!out->start || !out->nstart || !out->area || !out->xy || !out->neighbours || !bd.ring_start ||
         (rc = gp_rt_rings(rt, bd.ring_start, NULL, &bd.rings, progress))) {
@@ -388,6 +454,54 @@ done:
     if (rc)
         gp_cells_free(out);
     return rc;
+}
+
+/* The cells on a periodic domain (docs/method.md §5.1): the ghost layer, its own regular
+ * triangulation, and the cells of the real disks, with the margin doubled until every
+ * cell is complete. */
+static int periodic_cells(const gp_domain *domain, const gp_disk *disks, size_t n,
+                          const gp_laguerre_params *params, const gp_progress *progress,
+                          gp_cells *out, gp_error *err)
+{
+    double R_max = 0.0;
+    for (size_t i = 0; i < n; i++)
+        R_max = disks[i].R > R_max ? disks[i].R : R_max;
+    double period = (domain->periodic & GP_PERIODIC_X) ? domain->width : domain->height;
+    if ((domain->periodic & GP_PERIODIC_Y) && domain->height < period)
+        period = domain->height;
+    memset(out, 0, sizeof *out);
+    for (double margin = GHOST_MARGIN_RADII * R_max;; margin *= 2.0) {
+        if (margin > period)
+            margin = period;
+        gp_disk *all;
+        int32_t *origin;
+        size_t m;
+        if (periodic_images(domain, disks, n, margin, &all, &origin, &m))
+            return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the periodic images");
+        gp_rt *rt;
+        int rc = gp_rt_build(all, m, progress, &rt, err);
+        if (rc == 0) {
+            rc = build_cells(domain, all, n, rt, origin, margin, R_max, params, progress, out, err);
+            gp_rt_free(rt);
+        }
+        free(all);
+        free(origin);
+        if (rc != CELL_INCOMPLETE)
+            return rc;
+        if (margin >= period)
+            return gp_error_set(err, GP_EGEOM, NULL,
+                                "a periodic cell reaches beyond a whole period of images: the "
+                                "domain is too small for its largest void");
+    }
+}
+
+int gp_laguerre(const gp_domain *domain, const gp_disk *disks, size_t n, const gp_rt *rt,
+                const gp_laguerre_params *params, const gp_progress *progress,
+                gp_cells *out, gp_error *err)
+{
+    if (domain->periodic)
+        return periodic_cells(domain, disks, n, params, progress, out, err);
+    return build_cells(domain, disks, n, rt, NULL, 0.0, 0.0, params, progress, out, err);
 }
 
 void gp_cells_free(gp_cells *cells)

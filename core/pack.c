@@ -63,6 +63,7 @@ int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level)
     if (pk->count == pk->capacity && grow_disks(pk))
         return gp_error_set(pk->err, GP_ENOMEM, NULL, "out of memory after %zu disks", pk->count);
     int32_t id = (int32_t)pk->count++;
+    gp_domain_wrap(pk->params->domain, &x, &y); /* a disk across a periodic side: its image inside */
     pk->disks[id] = (gp_disk){x, y, pk->pending_r, pk->pending_R};
     pk->level[id] = level;
     pk->closings[id] = 0;
@@ -90,8 +91,8 @@ int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, in
 /* Whether the disk (x, y, R) overlaps disk `id` (cheap test run before the grid's). */
 static int overlaps_disk(const packer *pk, double x, double y, double R, int32_t id)
 {
-    gp_disk candidate = {x, y, R, R};
-    return gp_disks_overlap(&candidate, &pk->disks[id]);
+    gp_disk candidate = {x, y, R, R}, image;
+    return gp_disks_overlap(&candidate, pack_image(pk, &pk->disks[id], x, y, &image));
 }
 
 static int front_oom(packer *pk)
@@ -169,8 +170,11 @@ static void mark_failed(packer *pk, int32_t u, double R)
     double limit = R;
     if (pk->blocked >= 0) {
         const front_node *n = &pk->fr.nodes[u];
-        limit = pack_fit_limit(&pk->disks[n->disk], &pk->disks[pk->fr.nodes[n->next].disk],
-                               n->length, n->ux, n->uy, &pk->disks[pk->blocked], pk->R_min, R);
+        const gp_disk *a = &pk->disks[n->disk];
+        gp_disk b_image, q_image;
+        limit = pack_fit_limit(a, pack_image(pk, &pk->disks[pk->fr.nodes[n->next].disk], a->x, a->y, &b_image),
+                               n->length, n->ux, n->uy,
+                               pack_image(pk, &pk->disks[pk->blocked], a->x, a->y, &q_image), pk->R_min, R);
     }
     front_mark_failed(&pk->fr, u, limit);
 }
@@ -243,15 +247,19 @@ static long gather_conflicts(packer *pk, double x, double y, int32_t u)
 static int32_t closing_node(const packer *pk, size_t n, int32_t u)
 {
     int32_t p1 = seg_from(pk, u), p2 = seg_to(pk, u);
-    const gp_disk *d1 = &pk->disks[p1], *d2 = &pk->disks[p2];
+    const gp_disk *d1 = &pk->disks[p1];
+    gp_disk d2_image, di_image;
+    const gp_disk *d2 = pack_image(pk, &pk->disks[p2], d1->x, d1->y, &d2_image);
     double best_gap = INFINITY;
     int32_t best = FRONT_NONE;
     for (size_t i = 0; i < n; i++) {
         int32_t id = pk->conflicts[i];
-        const gp_disk *di = &pk->disks[id];
+        const gp_disk *di = pack_image(pk, &pk->disks[id], d1->x, d1->y, &di_image);
         if (id == p1 || id == p2 || gp_orient2d(d1->x, d1->y, d2->x, d2->y, di->x, di->y) <= 0.0)
             continue;
         int32_t w = front_node_on_loop(&pk->fr, id, u);
+        if (w == FRONT_NONE)
+            w = front_node_on_winding_loop(&pk->fr, id, u); /* periodic: loops that meet */
         if (w == FRONT_NONE)
             continue;
         double gap = closing_gap(d1, d2, di);
@@ -283,7 +291,10 @@ static int close_front(packer *pk, int32_t u)
         return 0;
     }
     pk->closings[p1]++;
-    if (gp_place_tangent(&pk->disks[p1], &pk->disks[p2], pk->pending_R, &x, &y)) {
+    gp_disk p2_image;
+    const gp_disk *d1 = &pk->disks[p1];
+    if (gp_place_tangent(d1, pack_image(pk, &pk->disks[p2], d1->x, d1->y, &p2_image),
+                         pk->pending_R, &x, &y)) {
         long n = gather_conflicts(pk, x, y, u);
         if (n < 0)
             return (int)n;
@@ -422,6 +433,16 @@ gp_pack_law_limit gp_pack_check_law(const gp_domain *domain, const gp_distributi
                      R_min, side, side / R_min, GP_PACK_MAX_SIDE_RADII);
         return GP_PACK_LAW_PRECISION;
     }
+    double period = GP_PACK_MIN_PERIOD_RADII * R_max;
+    if (((domain->periodic & GP_PERIODIC_X) && !(domain->width >= period)) ||
+        ((domain->periodic & GP_PERIODIC_Y) && !(domain->height >= period))) {
+        gp_error_set(err, GP_EINVAL, NULL,
+                     "a periodic side must be at least %g largest packing radii long (%g for "
+                     "R_max = %g), so that only the nearest image of a disk can touch another "
+                     "(docs/method.md §3.8)",
+                     GP_PACK_MIN_PERIOD_RADII, period, R_max);
+        return GP_PACK_LAW_PERIOD;
+    }
     return GP_PACK_LAW_OK;
 }
 
@@ -520,7 +541,7 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
     }
     if (rc == 0) {
         draw_radius(&pk);
-        rc = pack_walls(&pk);
+        rc = params->domain->periodic ? pack_periodic_start(&pk) : pack_walls(&pk);
     }
     if (rc == 0)
         rc = run_front(&pk);

@@ -40,7 +40,7 @@ int gp_pack_default_rule(const gp_distribution *dist, const gp_joint *joint,
     double side = sqrt(GP_PACK_PILOT_DISKS * M_PI * mean_R2 / PILOT_FILL);
     if (side < 4.0 * R_max)
         side = 4.0 * R_max;
-    gp_domain pilot = {side, side};
+    gp_domain pilot = {side, side, 0};
     /* the pilots honour the caller's cancel flag; their progress is not the job's */
     gp_progress quiet = {NULL, NULL, progress ? progress->cancel : NULL};
     double best = -1.0;

@@ -1,5 +1,6 @@
-/* packer.h - the packer's state and the helpers its two parts share (internal to core/):
- * pack.c runs the advancing front, pack_walls.c lays the initial front along the walls. */
+/* packer.h - the packer's state and the helpers its parts share (internal to core/):
+ * pack.c runs the advancing front, pack_walls.c lays the initial front along the walls,
+ * pack_periodic.c starts it on a periodic domain. */
 #ifndef GRAINPACK_CORE_PACKER_H
 #define GRAINPACK_CORE_PACKER_H
 
@@ -82,5 +83,26 @@ double pack_fit_limit(const gp_disk *a, const gp_disk *b, double d, double ux, d
 /* Lays the initial front along the walls (docs/method.md §3.2) and hands its loop to the
  * front. Returns 0 or a GP_E code with err set. */
 int pack_walls(packer *pk);
+
+/* The initial front of a periodic domain (docs/method.md §3.8): a seed cluster of three
+ * mutually tangent disks on a torus, or a chain of disks along each wall of a strip
+ * periodic along the other axis. Returns 0 or a GP_E code with err set. */
+int pack_periodic_start(packer *pk);
+
+/* Disk d as seen from (x, y): d itself on a walled domain; on a periodic one a copy of d
+ * at its image nearest (x, y), written to *image (the caller's). */
+static inline const gp_disk *pack_image(const packer *pk, const gp_disk *d, double x, double y,
+                                        gp_disk *image)
+{
+    const gp_domain *dom = pk->params->domain;
+    if (!dom->periodic)
+        return d;
+    double dx = d->x - x, dy = d->y - y;
+    gp_domain_min_image(dom, &dx, &dy);
+    *image = *d;
+    image->x = x + dx;
+    image->y = y + dy;
+    return image;
+}
 
 #endif

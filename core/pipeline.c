@@ -46,6 +46,14 @@ static int mesh(const gp_spec *spec, gp_result *result, const gp_rt *rt,
     return rc;
 }
 
+/* Whether a stage needs the regular triangulation of the disks: the cells of a periodic
+ * domain build their own, with the ghost layer (docs/method.md §5.1). */
+static int needs_rt(const gp_spec *spec)
+{
+    return spec->balance_enabled || spec->mesh_enabled ||
+           (spec->laguerre_enabled && !spec->domain.periodic);
+}
+
 int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,
                     gp_result *result, gp_error *err)
 {
@@ -59,7 +67,7 @@ int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *pr
         goto fail;
     record(result, "pack", t0);
 
-    if (spec->balance_enabled || spec->laguerre_enabled || spec->mesh_enabled) {
+    if (needs_rt(spec)) {
         /* one triangulation serves every stage: balancing keeps it up to date; the mesh of
            disks in a matrix finds their contacts in it */
         t0 = now_seconds();
@@ -123,8 +131,8 @@ int gp_result_rederive(const gp_spec *spec, gp_result *result, gp_error *err)
     gp_packing *pk = &result->packing;
     if (!spec->balance_enabled && !spec->laguerre_enabled && !spec->mesh_enabled)
         return 0;
-    gp_rt *rt;
-    int rc = gp_rt_build(pk->disks, pk->count, NULL, &rt, err);
+    gp_rt *rt = NULL;
+    int rc = needs_rt(spec) ? gp_rt_build(pk->disks, pk->count, NULL, &rt, err) : 0;
     if (rc)
         return rc;
     if (spec->balance_enabled) {

@@ -154,6 +154,41 @@ static int get_choice(validator *v, const json_t *obj, const char *base, const c
                         json_string_value(value));
 }
 
+/* "periodic": true (both axes), false, or an array of distinct "x", "y" (docs/method.md
+ * §3.8); absent is false. */
+static int parse_periodic(validator *v, const json_t *obj, const char *base, unsigned *out)
+{
+    static const char expected[] = "true, false or an array of distinct \"x\", \"y\"";
+    char ptr[GP_ERROR_POINTER_MAX], item_ptr[GP_ERROR_POINTER_MAX];
+    pointer_key(ptr, base, "periodic");
+    const json_t *value = json_object_get(obj, "periodic");
+    *out = 0;
+    if (!value || json_is_false(value))
+        return 0;
+    if (json_is_true(value)) {
+        *out = GP_PERIODIC_X | GP_PERIODIC_Y;
+        return 0;
+    }
+    if (!json_is_array(value))
+        return gp_error_set(v->err, GP_EINVAL, ptr, "must be %s, got %s", expected, type_phrase(value));
+    size_t i;
+    const json_t *item;
+    json_array_foreach(value, i, item) {
+        pointer_index(item_ptr, ptr, i);
+        const char *axis = json_is_string(item) ? json_string_value(item) : NULL;
+        unsigned bit = !axis ? 0 : strcmp(axis, "x") == 0 ? GP_PERIODIC_X
+                                 : strcmp(axis, "y") == 0 ? GP_PERIODIC_Y : 0;
+        if (!bit)
+            return gp_error_set(v->err, GP_EINVAL, item_ptr, "must be \"x\" or \"y\", got %s",
+                                type_phrase(item));
+        if (*out & bit)
+            return gp_error_set(v->err, GP_EINVAL, item_ptr, "repeats \"%s\"; expected %s", axis,
+                                expected);
+        *out |= bit;
+    }
+    return 0;
+}
+
 static int parse_domain(validator *v, const json_t *inputs, const char *base, gp_domain *dom)
 {
     char ptr[GP_ERROR_POINTER_MAX];
@@ -161,12 +196,14 @@ static int parse_domain(validator *v, const json_t *inputs, const char *base, gp
     int rc = get_object(v, inputs, base, "domain", 1, &obj, ptr);
     if (rc)
         return rc;
-    static const char *const members[] = {"width", "height", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "width, height")))
+    static const char *const members[] = {"width", "height", "periodic", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "width, height, periodic")))
         return rc;
     if ((rc = get_number(v, obj, ptr, "width", 0.0, 0, &dom->width)))
         return rc;
-    return get_number(v, obj, ptr, "height", 0.0, 0, &dom->height);
+    if ((rc = get_number(v, obj, ptr, "height", 0.0, 0, &dom->height)))
+        return rc;
+    return parse_periodic(v, obj, ptr, &dom->periodic);
 }
 
 static int parse_histogram(validator *v, const json_t *obj, const char *base, gp_distribution *d)
@@ -560,12 +597,22 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
     char ptr[GP_ERROR_POINTER_MAX], color_ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
     spec->picture_color = spec->balance_enabled ? GP_PICTURE_COLOR_QUALITY : GP_PICTURE_COLOR_RADIUS;
+    spec->picture_tile = 1;
     int rc = get_object(v, inputs, base, "picture", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
-    static const char *const members[] = {"color", "disks", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "color, disks")))
+    static const char *const members[] = {"color", "disks", "tile", NULL};
+    if ((rc = check_members(v, obj, ptr, members, "color, disks, tile")))
         return rc;
+    if ((rc = get_integer(v, obj, ptr, "tile", 1, GP_PICTURE_MAX_TILE, &spec->picture_tile)))
+        return rc;
+    if (spec->picture_tile > 1 && !spec->domain.periodic) {
+        char tile_ptr[GP_ERROR_POINTER_MAX];
+        pointer_key(tile_ptr, ptr, "tile");
+        return gp_error_set(v->err, GP_EINVAL, tile_ptr,
+                            "tiles a periodic domain only; add \"periodic\" to the domain or leave "
+                            "\"tile\" out");
+    }
     if (json_object_get(obj, "color")) {
         static const char *const colors[] = {"radius", "quality", NULL};
         int color;
@@ -699,12 +746,25 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
     gp_pack_law_limit limit = gp_pack_check_law(&spec->domain, &spec->dist, &spec->joint, v->err);
     if (limit != GP_PACK_LAW_OK) {
         /* the joint is at fault when the grain radii alone are within the ratio */
-        if (limit == GP_PACK_LAW_RATIO && r_max <= GP_PACK_MAX_RADIUS_RATIO * r_min)
+        if (limit == GP_PACK_LAW_PERIOD)
+            pointer_key(v->err->pointer, domain_ptr, "periodic");
+        else if (limit == GP_PACK_LAW_RATIO && r_max <= GP_PACK_MAX_RADIUS_RATIO * r_min)
             snprintf(v->err->pointer, sizeof v->err->pointer, "%s", joint_ptr);
         else
             smallest_radius_pointer(base, &spec->dist, v->err->pointer);
         return GP_EINVAL;
     }
+    /* the stages that do not take a periodic domain yet (docs/method.md §3.8) */
+    static const char *const walled_only[] = {"balance", "mesh"};
+    int enabled[] = {spec->balance_enabled, spec->mesh_enabled};
+    for (size_t k = 0; k < sizeof enabled / sizeof enabled[0]; k++)
+        if (spec->domain.periodic && enabled[k]) {
+            char stage_ptr[GP_ERROR_POINTER_MAX];
+            pointer_key(stage_ptr, base, walled_only[k]);
+            return gp_error_set(v->err, GP_EINVAL, stage_ptr,
+                                "does not take a periodic domain yet; leave it out, or give the "
+                                "domain walls (no \"periodic\")");
+        }
     spec->expected_disks = gp_spec_expected_disks(&spec->domain, &spec->dist, &spec->joint);
     double bound = gp_spec_disk_bound(&spec->domain, &spec->dist, &spec->joint);
     if (!(bound <= (double)v->max_disks))

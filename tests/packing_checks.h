@@ -69,16 +69,44 @@ static inline size_t count_overlaps(const gp_disk *disks, size_t n, double *wors
     return bad;
 }
 
-/* The number of packing disks sticking out of the rectangle by more than the tolerance. */
+/* The k x k tiling of a periodic packing: the disks copied by (i W, j H) for
+ * 0 <= i, j < k along the periodic axes (k copies, or one along a walled axis), in a new
+ * array (the caller's) of *n_out disks. Any two disks that overlap under the minimum-image
+ * convention overlap in the 3 x 3 tiling (the middle copy of one and a copy of the other),
+ * so count_overlaps on it checks the packing across its sides with no minimum image. */
+static inline gp_disk *tile_packing(const gp_disk *disks, size_t n, const gp_domain *dom, int k,
+                                    size_t *n_out)
+{
+    int kx = (dom->periodic & GP_PERIODIC_X) ? k : 1, ky = (dom->periodic & GP_PERIODIC_Y) ? k : 1;
+    gp_disk *t = malloc((n ? n : 1) * (size_t)(kx * ky) * sizeof *t);
+    size_t m = 0;
+    for (int i = 0; i < kx; i++)
+        for (int j = 0; j < ky; j++)
+            for (size_t a = 0; a < n; a++) {
+                t[m] = disks[a];
+                t[m].x += i * dom->width;
+                t[m].y += j * dom->height;
+                m++;
+            }
+    *n_out = m;
+    return t;
+}
+
+/* The number of disks whose disk crosses a wall by more than the tolerance, or along a
+ * periodic axis whose centre is outside [0, W) x [0, H) (a disk across a periodic side is
+ * stored once, at its image inside). */
 static inline size_t count_outside(const gp_disk *disks, size_t n, const gp_domain *dom)
 {
     size_t bad = 0;
     for (size_t i = 0; i < n; i++) {
         const gp_disk *d = &disks[i];
         double slack = d->R * TEST_BOUNDARY_RTOL;
-        if (d->x - d->R < -slack || d->y - d->R < -slack || d->x + d->R > dom->width + slack ||
-            d->y + d->R > dom->height + slack)
-            bad++;
+        int px = (dom->periodic & GP_PERIODIC_X) != 0, py = (dom->periodic & GP_PERIODIC_Y) != 0;
+        int out_x = px ? !(d->x >= 0.0 && d->x < dom->width)
+                       : (d->x - d->R < -slack || d->x + d->R > dom->width + slack);
+        int out_y = py ? !(d->y >= 0.0 && d->y < dom->height)
+                       : (d->y - d->R < -slack || d->y + d->R > dom->height + slack);
+        bad += out_x || out_y;
     }
     return bad;
 }

@@ -29,7 +29,7 @@ static void quality_of(const gp_domain *dom, const gp_disk *d, size_t n, double 
 
 static void test_hexagonal_patch_is_perfectly_balanced(void)
 {
-    gp_domain dom = {20.0, 20.0};
+    gp_domain dom = {20.0, 20.0, 0};
     gp_disk d[49];
     size_t n = hex_patch(d, 7, 7, 3.0, 3.0);
     double F[49];
@@ -51,7 +51,7 @@ static void test_one_neighbour_moved_away_gives_its_gap(void)
 {
     /* the centre of the patch (row 3, col 3) sees one neighbour pushed out radially by g:
      * h = g toward it, 0 toward the five others, so F = g / R = g */
-    gp_domain dom = {20.0, 20.0};
+    gp_domain dom = {20.0, 20.0, 0};
     gp_disk d[49];
     size_t n = hex_patch(d, 7, 7, 3.0, 3.0);
     size_t centre = 3 * 7 + 3, right = 3 * 7 + 4;
@@ -70,7 +70,7 @@ static void test_one_neighbour_moved_away_gives_its_gap(void)
         e[i].x *= 2.0; /* spread so that a centre of radius 2 fits */
         e[i].y *= 2.0;
     }
-    dom = (gp_domain){60.0, 60.0};
+    dom = (gp_domain){60.0, 60.0, 0};
     /* neighbours at distance 4, radius 1: gaps 4 - 2 - 1 = 1; one moved out by 0.5 */
     e[centre].R = 2.0;
     e[right].x += 0.5;
@@ -239,7 +239,7 @@ static void test_relocation_of_a_large_structure_ends_steady(void)
      * sweeps, seed 1, where the stall rule ran 22) with the best structure seen */
     gp_spec spec;
     load_example("variable", &spec);
-    spec.domain = (gp_domain){50.0 * sqrt(1e5 / 1260.0), 50.0 * sqrt(1e5 / 1260.0)};
+    spec.domain = (gp_domain){50.0 * sqrt(1e5 / 1260.0), 50.0 * sqrt(1e5 / 1260.0), 0};
     summary s = check_balance(&spec, 1, GP_BALANCE_RELOCATION, "variable 10^5");
     CHECK_MSG(s.stop == GP_BALANCE_STOP_STEADY && s.sweeps < GP_BALANCE_STALL_SWEEPS &&
                   s.sweeps >= s.best_sweep + GP_BALANCE_STEADY_SWEEPS,

@@ -18,7 +18,7 @@ typedef struct fixture {
  * touching: the loop is a convex polygon. */
 static void setup(fixture *fx, int n)
 {
-    fx->dom = (gp_domain){40, 40};
+    fx->dom = (gp_domain){40, 40, 0};
     fx->disks = calloc(64, sizeof *fx->disks);
     fx->levels = calloc(64, sizeof *fx->levels);
     gp_grid_init(&fx->grid, &fx->dom, 1.0, 64, 1 << 16);

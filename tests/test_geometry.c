@@ -85,7 +85,7 @@ static void test_joint_laws_and_packing_range(void)
 
 static void test_domain_corners_and_containment(void)
 {
-    gp_domain d = {237, 300};
+    gp_domain d = {237, 300, 0};
     double x, y;
     gp_domain_corner(&d, 2, &x, &y);
     CHECK(x == 237 && y == 300);
@@ -97,7 +97,7 @@ static void test_domain_corners_and_containment(void)
 
 static void test_grid_finds_exactly_the_overlaps_brute_force_finds(void)
 {
-    gp_domain dom = {20, 10};
+    gp_domain dom = {20, 10, 0};
     enum { N = 2000 };
     gp_disk *disks = malloc(N * sizeof *disks);
     gp_rng rng;
@@ -137,7 +137,7 @@ static void test_grid_finds_exactly_the_overlaps_brute_force_finds(void)
 
 static void test_grid_refuses_too_many_cells(void)
 {
-    gp_domain dom = {1e6, 1e6};
+    gp_domain dom = {1e6, 1e6, 0};
     gp_grid grid;
     CHECK(gp_grid_init(&grid, &dom, 0.001, 16, 1000000) == GP_ETOOBIG);
 }

@@ -56,7 +56,7 @@ static size_t disagreements(nearby *nb, const gp_disk *d, size_t n, const gp_dom
 static void test_clear_positions_are_those_brute_force_finds(void)
 {
     /* disks of radii 0.2 to 1 at random, overlapping or not: the predicate does not care */
-    gp_domain dom = {60.0, 40.0};
+    gp_domain dom = {60.0, 40.0, 0};
     gp_disk *d = malloc(DISKS * sizeof *d);
     gp_rng rng;
     gp_rng_seed(&rng, 11);
@@ -94,7 +94,7 @@ static void test_gathering_keeps_only_disks_that_can_reach_the_box(void)
     /* a row of unit disks 3 apart: a box around disk 5 of half-width 1.25 can be reached
      * by disks whose centres are within 1 + 1 of it, that is its neighbours 3 away (1.75
      * from the box's edge) but not the next ones (4.75 from it) */
-    gp_domain dom = {40.0, 4.0};
+    gp_domain dom = {40.0, 4.0, 0};
     gp_disk d[12];
     for (int i = 0; i < 12; i++)
         d[i] = (gp_disk){1.5 + 3.0 * i, 2.0, 1.0, 1.0};

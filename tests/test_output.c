@@ -28,7 +28,7 @@ static void run_example(const char *name, gp_spec *spec, gp_result *result)
 
 static void test_statistics_of_a_hand_made_packing(void)
 {
-    gp_domain dom = {10, 10};
+    gp_domain dom = {10, 10, 0};
     gp_bin bins[2] = {{1.0, 2.0, 0.5}, {2.0, 3.0, 0.5}};
     gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
     gp_disk disks[4] = {{2, 2, 1.5, 2.0}, {7, 2, 1.0, 1.5}, {2, 7, 2.5, 2.5}, {7, 7, 3.0, 3.0}};

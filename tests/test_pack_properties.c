@@ -419,7 +419,7 @@ static void test_laws_beyond_the_limits_are_refused_not_packed(void)
     gp_bin bins[2] = {{1e-6, 2e-6, 0.5}, {1.0, 1.1, 0.5}};
     gp_distribution dist = {.kind = GP_DIST_HISTOGRAM, .nbins = 2, .bins = bins};
     CHECK(gp_distribution_prepare(&dist) == 0);
-    gp_domain dom = {100, 100};
+    gp_domain dom = {100, 100, 0};
     gp_pack_params params = {.domain = &dom, .dist = &dist, .seed = 1, .rule = GP_FRONT_DEFAULT};
     gp_packing pk;
     gp_error err;
@@ -429,7 +429,7 @@ static void test_laws_beyond_the_limits_are_refused_not_packed(void)
     /* within the ratio, but too small for the domain's precision */
     bins[0] = (gp_bin){0.02, 0.021, 0.5};
     bins[1] = (gp_bin){1.0, 1.1, 0.5};
-    gp_domain strip = {30000, 2.5};
+    gp_domain strip = {30000, 2.5, 0};
     params.domain = &strip;
     CHECK(gp_pack(&params, NULL, &pk, &err) == GP_EINVAL);
     CHECK(strstr(err.message, "too small for a domain side of 30000") != NULL);
@@ -511,7 +511,7 @@ static void test_cancel_stops_the_worst_law_at_the_next_check(void)
         /* a domain whose walls alone hold 300 000 disks, where the first report must come
          * from the walk along the walls (their first ~40 disks, not their end at 1% of the
          * fill), and one where it comes from the front */
-        gp_domain dom = walls_only ? (gp_domain){3000, 3} : (gp_domain){30, 30};
+        gp_domain dom = walls_only ? (gp_domain){3000, 3, 0} : (gp_domain){30, 30, 0};
         gp_pack_params params = {.domain = &dom, .dist = &dist, .seed = 1, .rule = GP_FRONT_WAIT,
                                  .wait_levels = 4};
         cancel_on_report c = {0, 0, 0.0};

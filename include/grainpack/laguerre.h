@@ -61,6 +61,12 @@ typedef struct gp_cells {
  * the cell is shrunk as params asks. Reports progress as stage "laguerre", honours
  * progress->cancel.
  *
+ * On a periodic domain (docs/method.md §5.1) `rt` is not used (it may be NULL): the cells
+ * are those among all the periodic images, from a ghost layer of images near the sides
+ * and its own triangulation; they are clipped only by the walled sides, a cell across a
+ * periodic side is one polygon in unwrapped coordinates around its disk (it sticks out of
+ * the domain), its neighbours are grain ids, and the cells' areas sum to W H.
+ *
  * On success returns 0 and `out` owns its arrays (free with gp_cells_free). Fails with
  * GP_ENOMEM, GP_ECANCELED, or GP_EGEOM when a centre lies outside its own cell (a disk
  * outside the domain, or overlapping disks); err says which; `out` is zeroed. */

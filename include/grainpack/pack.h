@@ -61,15 +61,21 @@ typedef struct gp_pack_params {
  * is off by ~3e-11 of its radius (measured), 30 times inside GP_CONTACT_RTOL; at 10^8 the
  * rounding exceeds the tolerance, disks overlap and a wall can stall. */
 #define GP_PACK_MAX_SIDE_RADII 1e6
+/* The shortest periodic side, in largest packing radii (docs/method.md §3.8): 12 radii
+ * make at least three grid cells of 2 R_max per period (no image counted twice) and keep
+ * every front segment (under 4 R_max) and every contact (2 R_max) under half a period,
+ * so that the nearest image of a neighbour is the only one that can touch. */
+#define GP_PACK_MIN_PERIOD_RADII 12.0
 
 /* Why a law cannot be packed in a domain (gp_pack_check_law). */
 typedef enum gp_pack_law_limit {
     GP_PACK_LAW_OK = 0,
     GP_PACK_LAW_RATIO,     /* R_max / R_min above GP_PACK_MAX_RADIUS_RATIO */
-    GP_PACK_LAW_PRECISION  /* a domain side above GP_PACK_MAX_SIDE_RADII smallest radii */
+    GP_PACK_LAW_PRECISION, /* a domain side above GP_PACK_MAX_SIDE_RADII smallest radii */
+    GP_PACK_LAW_PERIOD     /* a periodic side under GP_PACK_MIN_PERIOD_RADII largest radii */
 } gp_pack_law_limit;
 
-/* Checks the two bounds above for `dist` (with `joint`, which may be NULL) in `domain`.
+/* Checks the three bounds above for `dist` (with `joint`, which may be NULL) in `domain`.
  * Returns GP_PACK_LAW_OK, or the bound broken with err's message saying which and why
  * (err's pointer left empty for the caller to name the field). */
 GP_API gp_pack_law_limit gp_pack_check_law(const gp_domain *domain, const gp_distribution *dist,

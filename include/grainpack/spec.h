@@ -41,6 +41,10 @@ typedef struct gp_spec_limits {
  * largest packings the disk cap allows (bench/). */
 #define GP_SPEC_MAX_BALANCE_ITERATIONS 100000
 
+/* The most copies of a periodic domain the picture tiles along an axis: enough to see
+ * that the copies join with no seam, and the picture stays the size of one domain's. */
+#define GP_PICTURE_MAX_TILE 4
+
 /* What the SVG picture colours grains by. */
 typedef enum gp_picture_color {
     GP_PICTURE_COLOR_RADIUS = 0, /* the grain radius r */
@@ -63,6 +67,8 @@ typedef struct gp_spec {
     gp_laguerre_params laguerre; /* "laguerre": {"shrink", "flush_boundary"} */
     gp_picture_color picture_color; /* "picture": {"color"}: quality when balancing, else radius */
     int picture_disks;     /* "picture": {"disks"}: outline the grain disks over the cells */
+    int picture_tile;      /* "picture": {"tile"}: copies of a periodic domain drawn along each
+                              periodic axis, 1 to GP_PICTURE_MAX_TILE (1 when absent) */
     int mesh_enabled;      /* the spec has "mesh" */
     gp_mesh_params mesh;   /* "mesh": {"element_size", "min_angle", "order", "band_layers",
                               "band_size", "disk_tolerance", "abaqus": {"plane", "reduced"}} */
