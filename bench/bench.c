@@ -22,13 +22,7 @@
 #include "grainpack/pack.h"
 #include "grainpack/spec.h"
 #include "grainpack/stats.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
+#include "bench_util.h"
 
 static int compare_double(const void *a, const void *b)
 {
@@ -69,12 +63,12 @@ static case_result run_case(const gp_spec *spec, const gp_pack_params *params, i
     for (int i = 0; i < runs; i++) {
         gp_packing pk;
         gp_error err;
-        double t0 = now();
+        double t0 = bench_now();
         if (gp_pack(params, NULL, &pk, &err)) {
             fprintf(stderr, "pack failed: %s\n", err.message);
             exit(1);
         }
-        times[i] = now() - t0;
+        times[i] = bench_now() - t0;
         if (i == 0) {
             gp_pack_stats_compute(&spec->domain, &spec->dist, &pk, &res.stats);
             res.disks = pk.count;
@@ -289,13 +283,6 @@ static void bench_report_sampling(const char *dir, int seeds)
 /* The clock of the scaling points: wall clock, or with --cpu the process's CPU time. */
 static clockid_t scaling_clock = CLOCK_MONOTONIC;
 
-static double scaling_now(void)
-{
-    struct timespec ts;
-    clock_gettime(scaling_clock, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
 /* One scaling point, in a child process so that its peak memory is its own: the default
  * rule (its pilots included in the time), or the report's rule with `band`. */
 static void scale_point(double target, int default_rule, uint32_t band)
@@ -320,9 +307,9 @@ static void scale_point(double target, int default_rule, uint32_t band)
                                  .rule = default_rule ? GP_FRONT_DEFAULT : GP_FRONT_LEVEL_BAND};
         gp_packing pk;
         gp_error err;
-        double t0 = scaling_now();
+        double t0 = bench_seconds(scaling_clock);
         int rc = gp_pack(&params, NULL, &pk, &err);
-        double t = scaling_now() - t0;
+        double t = bench_seconds(scaling_clock) - t0;
         getrusage(RUSAGE_SELF, &after);
         double bytes = (double)(after.ru_maxrss - before.ru_maxrss) * 1024.0;
         char line[256];
@@ -394,7 +381,7 @@ static void *cancel_thread(void *arg)
     gp_packing pk;
     gp_error err;
     cr->rc = gp_pack(cr->params, &progress, &pk, &err);
-    cr->returned = now();
+    cr->returned = bench_now();
     if (cr->rc == 0)
         gp_packing_free(&pk);
     return NULL;
@@ -430,9 +417,9 @@ static void bench_limits(int quick)
         gp_packing pk;
         gp_error err;
         params.max_disks = quick ? 20000 : 200000;
-        double t0 = scaling_now();
+        double t0 = bench_seconds(scaling_clock);
         int rc = gp_pack(&params, NULL, &pk, &err);
-        double t = scaling_now() - t0;
+        double t = bench_seconds(scaling_clock) - t0;
         size_t count = rc == 0 ? pk.count : params.max_disks;
         if (rc == 0)
             gp_packing_free(&pk);
@@ -448,7 +435,7 @@ static void bench_limits(int quick)
             exit(1);
         struct timespec nap = {(time_t)after, (long)((after - floor(after)) * 1e9)};
         nanosleep(&nap, NULL);
-        double raised = now();
+        double raised = bench_now();
         atomic_store(&cr.flag, 1);
         pthread_join(th, NULL);
         char stop[64];

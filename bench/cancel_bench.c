@@ -17,15 +17,9 @@
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
 #include "machine.h"
+#include "bench_util.h"
 
 #define MAX_RUNS 200
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
 
 /* What the progress callback saw: the stage running, and when each stage first
  * reported (the full run's stage boundaries). */
@@ -44,7 +38,7 @@ static void on_progress(void *ctx, const char *stage, double fraction)
     if (w->nstages == 0 || strcmp(w->stages[w->nstages - 1], stage) != 0) {
         if (w->nstages < 16) {
             w->stages[w->nstages] = stage;
-            w->first[w->nstages++] = now();
+            w->first[w->nstages++] = bench_now();
         }
     }
 }
@@ -73,7 +67,7 @@ static void *run_main(void *arg)
     gp_result result;
     gp_error err;
     r->rc = gp_pipeline_run(r->spec, 0, &progress, &result, &err);
-    r->ended = now();
+    r->ended = bench_now();
     r->ended_cpu = thread_cpu(CLOCK_THREAD_CPUTIME_ID);
     if (r->rc == 0) {
         r->disks = result.packing.count;
@@ -132,7 +126,7 @@ int main(int argc, char **argv)
     memset(&full, 0, sizeof full);
     full.spec = &spec;
     atomic_init(&full.cancel, 0);
-    double t0 = now();
+    double t0 = bench_now();
     run_main(&full);
     double total = full.ended - t0;
     if (full.rc) {
@@ -156,14 +150,14 @@ int main(int argc, char **argv)
         r->w.stage = "pack";
         atomic_init(&r->cancel, 0);
         pthread_t thread;
-        double start = now(), at = total * (k + 1) / (runs + 1);
+        double start = bench_now(), at = total * (k + 1) / (runs + 1);
         pthread_create(&thread, NULL, run_main, r);
         struct timespec ts = {(time_t)at, (long)((at - (double)(time_t)at) * 1e9)};
         nanosleep(&ts, NULL);
         stage[k] = __atomic_load_n(&r->w.stage, __ATOMIC_RELAXED);
         clockid_t clock;
         pthread_getcpuclockid(thread, &clock);
-        double raised = now(), raised_cpu = thread_cpu(clock);
+        double raised = bench_now(), raised_cpu = thread_cpu(clock);
         atomic_store(&r->cancel, 1);
         pthread_join(thread, NULL);
         latency[k] = r->rc == GP_ECANCELED ? r->ended - raised : -1.0;

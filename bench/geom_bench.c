@@ -18,23 +18,11 @@
 #include "grainpack/pack.h"
 #include "grainpack/spec.h"
 #include "machine.h"
+#include "bench_util.h"
 
 /* The clock of every timing: wall clock, or with --cpu the process's CPU time (one thread:
  * the same on a quiet machine, and far less noisy when other work shares the cores). */
 static clockid_t timing_clock = CLOCK_MONOTONIC;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(timing_clock, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-static void die(const char *what, const gp_error *err)
-{
-    fprintf(stderr, "%s: %s\n", what, err->message);
-    exit(1);
-}
 
 static void load(const char *dir, const char *name, gp_spec *spec)
 {
@@ -42,7 +30,7 @@ static void load(const char *dir, const char *name, gp_spec *spec)
     snprintf(path, sizeof path, "%s/%s.json", dir, name);
     gp_error err;
     if (gp_spec_load_file(path, NULL, spec, &err))
-        die(path, &err);
+        bench_die(path, &err);
 }
 
 static void pack(const gp_spec *spec, gp_packing *pk)
@@ -50,7 +38,7 @@ static void pack(const gp_spec *spec, gp_packing *pk)
     gp_pack_params params = gp_spec_pack_params(spec, 0);
     gp_error err;
     if (gp_pack(&params, NULL, pk, &err))
-        die("pack", &err);
+        bench_die("pack", &err);
 }
 
 /* Overlapping pairs by brute force over x-sorted disks (independent of the grid). */
@@ -92,12 +80,12 @@ static balanced balance_copy(const gp_spec *spec, const gp_packing *pk, gp_balan
     gp_error err;
     gp_rt *rt;
     if (gp_rt_build(d, pk->count, NULL, &rt, &err))
-        die("triangulation", &err);
+        bench_die("triangulation", &err);
     gp_balance_params params = {method, cap, max_step, update};
-    double t0 = now();
+    double t0 = bench_seconds(timing_clock);
     if (gp_balance(&spec->domain, d, pk->count, rt, &params, NULL, &out.br, &err))
-        die("balance", &err);
-    out.seconds = now() - t0;
+        bench_die("balance", &err);
+    out.seconds = bench_seconds(timing_clock) - t0;
     out.overlaps = overlaps(d, pk->count);
     gp_rt_free(rt);
     free(d);
@@ -191,10 +179,10 @@ static void work_build(const gp_spec *spec, const gp_packing *pk, const void *ct
     (void)ctx;
     gp_error err;
     gp_rt *rt;
-    double t0 = now();
+    double t0 = bench_seconds(timing_clock);
     if (gp_rt_build(pk->disks, pk->count, NULL, &rt, &err))
-        die("triangulation", &err);
-    out[0] = now() - t0;
+        bench_die("triangulation", &err);
+    out[0] = bench_seconds(timing_clock) - t0;
     gp_rt_free(rt);
 }
 
@@ -204,16 +192,16 @@ static void work_laguerre(const gp_spec *spec, const gp_packing *pk, const void 
     (void)ctx;
     gp_error err;
     gp_rt *rt;
-    double t0 = now();
+    double t0 = bench_seconds(timing_clock);
     if (gp_rt_build(pk->disks, pk->count, NULL, &rt, &err))
-        die("triangulation", &err);
-    out[0] = now() - t0;
+        bench_die("triangulation", &err);
+    out[0] = bench_seconds(timing_clock) - t0;
     gp_laguerre_params params = {GP_SHRINK_OFFSET, 0};
     gp_cells cells;
-    t0 = now();
+    t0 = bench_seconds(timing_clock);
     if (gp_laguerre(&spec->domain, pk->disks, pk->count, rt, &params, NULL, &cells, &err))
-        die("laguerre", &err);
-    out[1] = now() - t0;
+        bench_die("laguerre", &err);
+    out[1] = bench_seconds(timing_clock) - t0;
     gp_cells_free(&cells);
     gp_rt_free(rt);
 }

@@ -19,24 +19,12 @@
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
 #include "machine.h"
+#include "bench_util.h"
 
 /* Gmsh gets this long per run; beyond, the table says so. */
 #define GMSH_TIMEOUT_SECONDS 1800
 /* Gmsh's triangle count within this fraction of grainpack's needs no second run. */
 #define GMSH_COUNT_TOLERANCE 0.1
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-static void die(const char *what, const gp_error *err)
-{
-    fprintf(stderr, "%s: %s\n", what, err->message);
-    exit(1);
-}
 
 /* What one mesh run measured. */
 typedef struct measure {
@@ -74,10 +62,10 @@ static measure grainpack_mesh(const gp_spec *spec, const gp_result *r)
         gp_mesh_input in = {&spec->domain, r->packing.disks, r->packing.count, &r->cells, NULL, 0};
         gp_mesh mesh;
         gp_error err;
-        double t0 = now();
+        double t0 = bench_now();
         if (mesh_stage(&in, &spec->mesh, &mesh, &err))
-            die("mesh", &err);
-        measure m = {now() - t0, 0, 0, (double)(mesh.ntri + mesh.nquad), (double)mesh.ntri,
+            bench_die("mesh", &err);
+        measure m = {bench_now() - t0, 0, 0, (double)(mesh.ntri + mesh.nquad), (double)mesh.ntri,
                      (double)mesh.nquad, 0};
         getrusage(RUSAGE_SELF, &after);
         m.cpu = cpu_seconds(&after) - cpu_seconds(&before);
@@ -172,7 +160,7 @@ static double msh_surface_elements(const char *path)
 static measure gmsh_mesh(const char *geo, const char *msh)
 {
     measure m = {0};
-    double t0 = now();
+    double t0 = bench_now();
     fflush(stdout);
     pid_t pid = fork();
     if (pid == 0) {
@@ -186,7 +174,7 @@ static measure gmsh_mesh(const char *geo, const char *msh)
     int status;
     struct rusage u;
     wait4(pid, &status, 0, &u);
-    m.wall = now() - t0;
+    m.wall = bench_now() - t0;
     m.cpu = cpu_seconds(&u);
     m.peak_bytes = (double)u.ru_maxrss * 1024.0;
     if (WIFSIGNALED(status)) {
@@ -253,7 +241,7 @@ static void bench_case(const char *name, gp_spec *spec, int with_gmsh, const cha
     gp_result r;
     gp_error err;
     if (gp_pipeline_run(spec, 0, NULL, &r, &err))
-        die(name, &err);
+        bench_die(name, &err);
     gp_mesh_params_default(&spec->dist, &spec->mesh);
     if (rows != ROWS_LAYERS) {
         measure plain = grainpack_mesh(spec, &r);
@@ -276,7 +264,7 @@ static void load(const char *dir, const char *name, gp_spec *spec)
     snprintf(path, sizeof path, "%s/%s.json", dir, name);
     gp_error err;
     if (gp_spec_load_file(path, NULL, spec, &err))
-        die(path, &err);
+        bench_die(path, &err);
 }
 
 int main(int argc, char **argv)

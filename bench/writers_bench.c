@@ -12,13 +12,7 @@
 #include "grainpack/io.h"
 #include "sections.h"
 #include "machine.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_util.h"
 
 static int compare(const void *a, const void *b)
 {
@@ -55,7 +49,7 @@ static double write_once(const char *path, gp_format f, const gp_spec *spec, con
     }
     gp_out out;
     gp_out_init_file(&out, file);
-    double t0 = now();
+    double t0 = bench_now();
     int rc;
     if (through) {
         gp_sections_source *src = gp_sections_source_new(summary, read_stored, through, 0);
@@ -70,7 +64,7 @@ static double write_once(const char *path, gp_format f, const gp_spec *spec, con
         rc = gp_write_result(&out, f, spec, r);
     }
     fflush(file);
-    double t = now() - t0;
+    double t = bench_now() - t0;
     *bytes = ftell(file);
     fclose(file);
     gp_out_free(&out);
