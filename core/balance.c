@@ -14,6 +14,7 @@
 #include "nearby.h"
 #include "quality.h"
 #include "rings.h"
+#include "settled.h"
 
 /* Steps tried toward the target, as fractions w of the way: from the largest allowed
  * (gp_balance_params.max_step) down by 0.05 to 0.05, as report Algorithm 3 does from
@@ -48,6 +49,7 @@ typedef struct balancer {
     double max_step;
     rings rings;        /* the rings of the structure the sweep starts from */
     nearby near;        /* the disks near the positions a centre tries */
+    settled settled;    /* the centres whose last step still holds */
     double *F;          /* F of the structure the sweep starts from (NAN: not interior);
                            the result's array, which holds F of the best one at the end */
     uint8_t *changed;   /* rings the last update changed (gp_rt_mark_changes) */
@@ -71,7 +73,7 @@ static int gather(balancer *b, int32_t id, double x0, double y0, double x1, doub
 
 /* Whether the packing disk of `id` may sit at (x, y): inside the domain and clear of
  * every other disk, with the packer's contact tolerance. */
-static int position_is_free(const balancer *b, int32_t id, double x, double y)
+static int position_is_free(balancer *b, int32_t id, double x, double y)
 {
     double R = b->disks[id].R;
     return gp_domain_contains_disk(b->domain, x, y, R, R * GP_CONTACT_RTOL) &&
@@ -154,7 +156,7 @@ static int step_centre(balancer *b, int32_t id, const int32_t *ring, size_t degr
         p->x = x;
         p->y = y;
         nearby_move(&b->near, b->disks, id, old_x, old_y);
-        return 1;
+        return settled_moved(&b->settled, id, old_x, old_y, x, y) ? GP_ENOMEM : 1;
     }
     (*refused)++;
     return 0;
@@ -183,12 +185,36 @@ static int report(const gp_progress *progress, double fraction, gp_error *err)
     return 0;
 }
 
+/* Steps centre `id` (interior, with the given ring) unless its last step still holds
+ * (settled.h): 1 if it moved, 0 if not, or GP_ENOMEM. */
+static int visit(balancer *b, int32_t id, const int32_t *ring, size_t degree, uint64_t *refused)
+{
+    int held = settled_holds(&b->settled, b->disks, id, b->disks[id].R);
+    if (held != SETTLED_UNKNOWN) {
+        *refused += held == SETTLED_REFUSED;
+        return 0;
+    }
+    uint64_t refused_before = *refused;
+    int rc = step_centre(b, id, ring, degree, refused);
+    if (rc == 0)
+        settled_record(&b->settled, id, *refused != refused_before ? SETTLED_REFUSED : SETTLED_STILL,
+                       b->near.x0, b->near.y0, b->near.x1, b->near.y1);
+    if (rc == 1) {
+        /* its own step and its ring's read its position */
+        settled_forget(&b->settled, id);
+        for (size_t k = 0; k < degree; k++)
+            settled_forget(&b->settled, ring[k]);
+    }
+    return rc;
+}
+
 /* One sweep over the interior centres, in id order, each seeing the moves before it;
  * the ids moved go to b->moved. */
 static int sweep(balancer *b, const gp_progress *progress, double done, double share,
                  gp_balance_result *out, gp_error *err)
 {
     b->nmoved = 0;
+    settled_sweep(&b->settled);
     for (size_t i = 0; i < b->n; i++) {
         if (i % CENTRES_PER_REPORT == CENTRES_PER_REPORT - 1) {
             int rc = report(progress, done + share * (double)i / (double)b->n, err);
@@ -197,9 +223,11 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
         }
         size_t degree;
         const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
-        if (b->rings.hull[i] || degree < 3 || !inside_now(b, (int32_t)i, ring, degree))
+        if (b->rings.hull[i] || degree < 3 || !inside_now(b, (int32_t)i, ring, degree)) {
+            settled_forget(&b->settled, (int32_t)i);
             continue;
-        int rc = step_centre(b, (int32_t)i, ring, degree, &out->refused);
+        }
+        int rc = visit(b, (int32_t)i, ring, degree, &out->refused);
         if (rc < 0)
             return gp_error_set(err, rc, NULL, "out of memory balancing disk %zu", i);
         if (rc) {
@@ -223,6 +251,8 @@ static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp
             return gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
         if (!b->stale[i] && !b->changed[i])
             continue;
+        if (b->changed[i])
+            settled_forget(&b->settled, (int32_t)i); /* a step reads its ring */
         size_t degree;
         const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
         b->F[i] = quality_of_centre(b->domain, b->disks, (int32_t)i, ring, degree, b->rings.hull[i]);
@@ -324,6 +354,8 @@ static int start_sweeps(balancer *b, gp_rt *rt, const gp_progress *progress, gp_
     if (rc)
         return gp_error_set(err, rc, NULL, rc == GP_ETOOBIG ? "the bucket grid would be too large"
                                                            : "out of memory for the bucket grid");
+    if ((rc = settled_init(&b->settled, &b->near.grid, b->near.R_max, b->n)))
+        return gp_error_set(err, rc, NULL, "out of memory for the record of %zu centres", b->n);
     if ((rc = rings_init(&b->rings, rt, b->n, progress)))
         return rings_failed(rc, b->n, err);
     gp_rt_mark_changes(rt, b->changed);
@@ -443,6 +475,7 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
 done:
     gp_rt_mark_changes(rt, NULL);
     nearby_free(&b.near);
+    settled_free(&b.settled);
     rings_free(&b.rings);
     free(b.changed);
     free(b.stale);

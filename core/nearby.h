@@ -21,15 +21,28 @@ typedef struct nearby_entry {
 
 typedef struct nearby {
     gp_grid grid;       /* the cells; its lists hold the disks moved since the sort */
+    double R_max;       /* the largest radius */
     size_t n;
     uint32_t *start;    /* grid.ncells + 1: cell c sorted into entries start[c] .. start[c+1]-1 */
     nearby_entry *sorted; /* n entries in cell order; x is INFINITY once its disk has moved */
     uint32_t *entry;    /* per disk: its entry */
-    /* the disks gathered for one centre, and the box of positions they answer for */
-    double *gx, *gy, *gR;
+    /* the disks gathered for one centre of radius gR, and the box of positions they
+     * answer for; gr2: the square of the distance under which each overlaps that centre */
+    double *gx, *gy, *gr2, gR;
     size_t gn, gcap;
+    size_t blocker;     /* the gathered disk that blocked the last position tested, if any */
     double x0, y0, x1, y1;
 } nearby;
+
+/* Whether a disk of radius Rq at (x, y) is closer than R + Rq to the box [x0, x1] x
+ * [y0, y1]: the test that picks the disks nearby_gather gathers. */
+static inline int nearby_box_reaches(double x0, double y0, double x1, double y1, double x, double y,
+                                     double Rq, double R)
+{
+    double cx = x < x0 ? x0 : (x > x1 ? x1 : x), cy = y < y0 ? y0 : (y > y1 ? y1 : y);
+    double dx = x - cx, dy = y - cy, r = R + Rq;
+    return dx * dx + dy * dy < r * r;
+}
 
 /* Sets up nb for disks[0..n-1] (at most 2^31 - 1) of packing radius at most R_max in
  * `domain` (borrowed) and sorts them. Returns 0, GP_ENOMEM or GP_ETOOBIG (the grid
@@ -50,8 +63,9 @@ int nearby_gather(nearby *nb, const gp_disk *disks, int32_t id, double R, double
 
 /* Whether a disk of radius R at (x, y) overlaps no disk but `id` (GP_CONTACT_RTOL, the
  * predicate of gp_grid_first_overlap): tested against the gathered disks when (x, y)
- * lies in their box, else against the cells around it. */
-int nearby_is_clear(const nearby *nb, const gp_disk *disks, int32_t id, double R, double x, double y);
+ * lies in their box and R is the radius they were gathered for, else against the cells
+ * around it. Remembers which gathered disk blocked it, to test that one first next time. */
+int nearby_is_clear(nearby *nb, const gp_disk *disks, int32_t id, double R, double x, double y);
 
 void nearby_free(nearby *nb);
 
