@@ -3,7 +3,8 @@
  * tangent to its ball's boundary edges), refused when the step would overlap a disk or
  * leave the domain, until the structure stops improving (§4.5). Between sweeps only what
  * the moves changed is redone: the rings the triangulation's update changed, F where a
- * centre or a neighbour moved; the results are those of redoing everything, to the bit. */
+ * centre or a neighbour moved, the steps of centres whose last step read something that
+ * moved (settled.h); the results are those of redoing everything, to the bit. */
 #include "grow.h"
 #include "grainpack/balance.h"
 
@@ -208,6 +209,34 @@ static int visit(balancer *b, int32_t id, const int32_t *ring, size_t degree, ui
     return rc;
 }
 
+/* How far ahead of the centre being stepped its successors' data is asked for, in
+ * three stages (see nearby_prefetch_cells): the disk and its ring's ids, then the ring's
+ * disks and the cells around the disk, then the disks sorted in those cells. Why these
+ * distances: a centre takes about a microsecond, a read from memory a tenth of that, and
+ * each stage waits on the one before. */
+#define AHEAD_DISK 12
+#define AHEAD_CELLS 6
+#define AHEAD_ENTRIES 3
+
+/* Asks the memory for what visiting centre i will read (a hint: nothing changes). */
+static void prefetch_visit(const balancer *b, size_t i)
+{
+    if (i + AHEAD_DISK < b->n) {
+        __builtin_prefetch(&b->disks[i + AHEAD_DISK]);
+        __builtin_prefetch(&b->rings.ids[b->rings.start[i + AHEAD_DISK]]);
+    }
+    if (i + AHEAD_CELLS < b->n) {
+        size_t j = i + AHEAD_CELLS, degree;
+        const int32_t *ring = rings_of(&b->rings, (int32_t)j, &degree);
+        for (size_t k = 0; k < degree; k++)
+            __builtin_prefetch(&b->disks[ring[k]]);
+        nearby_prefetch_cells(&b->near, b->disks[j].x, b->disks[j].y);
+        settled_prefetch(&b->settled, b->disks[j].x, b->disks[j].y);
+    }
+    if (i + AHEAD_ENTRIES < b->n)
+        nearby_prefetch_entries(&b->near, b->disks[i + AHEAD_ENTRIES].x, b->disks[i + AHEAD_ENTRIES].y);
+}
+
 /* One sweep over the interior centres, in id order, each seeing the moves before it;
  * the ids moved go to b->moved. */
 static int sweep(balancer *b, const gp_progress *progress, double done, double share,
@@ -221,6 +250,7 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
             if (rc)
                 return rc;
         }
+        prefetch_visit(b, i);
         size_t degree;
         const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
         if (b->rings.hull[i] || degree < 3 || !inside_now(b, (int32_t)i, ring, degree)) {
@@ -249,6 +279,12 @@ static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp
     for (size_t i = 0; i < b->n; i++) {
         if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel))
             return gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
+        if (i + AHEAD_CELLS < b->n) {
+            size_t degree;
+            const int32_t *ring = rings_of(&b->rings, (int32_t)(i + AHEAD_CELLS), &degree);
+            for (size_t k = 0; k < degree; k++)
+                __builtin_prefetch(&b->disks[ring[k]]);
+        }
         if (!b->stale[i] && !b->changed[i])
             continue;
         if (b->changed[i])

@@ -58,6 +58,32 @@ void nearby_sort(nearby *nb, const gp_disk *disks)
     nb->start[0] = 0;
 }
 
+void nearby_prefetch_cells(const nearby *nb, double x, double y)
+{
+    const gp_grid *g = &nb->grid;
+    size_t c = gp_grid_cell(g, x, y);
+    for (int row = -1; row <= 1; row++) {
+        size_t first = c + (size_t)((ptrdiff_t)row * g->stride) - 1;
+        __builtin_prefetch(&nb->start[first]);
+        __builtin_prefetch(&nb->start[first + 3]);
+        __builtin_prefetch(&g->head[first]);
+        __builtin_prefetch(&g->head[first + 3]);
+    }
+}
+
+void nearby_prefetch_entries(const nearby *nb, double x, double y)
+{
+    const gp_grid *g = &nb->grid;
+    size_t c = gp_grid_cell(g, x, y);
+    for (int row = -1; row <= 1; row++) {
+        size_t first = c + (size_t)((ptrdiff_t)row * g->stride) - 1;
+        const nearby_entry *e = nb->sorted + nb->start[first], *end = nb->sorted + nb->start[first + 3];
+        /* two entries a cache line */
+        for (; e < end; e += 2)
+            __builtin_prefetch(e);
+    }
+}
+
 void nearby_move(nearby *nb, const gp_disk *disks, int32_t id, double old_x, double old_y)
 {
     nearby_entry *e = &nb->sorted[nb->entry[id]];

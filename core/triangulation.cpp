@@ -482,6 +482,12 @@ extern "C" void gp_rt_mark_changes(gp_rt *rt, uint8_t *marks) noexcept
     rt->marks = marks;
 }
 
+// How many moves ahead gp_rt_update_moved asks for a vertex, then for its face: a move
+// takes about a microsecond, a read from memory a tenth of that, and the face's address is
+// in the vertex.
+const size_t UPDATE_AHEAD_VERTEX = 8;
+const size_t UPDATE_AHEAD_FACE = 4;
+
 extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks,
                                   const int32_t *ids, size_t nids, gp_rt_update mode,
                                   gp_rt_update_stats *stats, const gp_progress *progress,
@@ -495,6 +501,12 @@ extern "C" int gp_rt_update_moved(gp_rt *rt, const gp_disk *disks, size_t ndisks
             if (k % GP_RT_INSERT_BATCH == GP_RT_INSERT_BATCH - 1 && gp_canceled(gp_progress_cancel(progress)))
                 return gp_error_set(err, GP_ECANCELED, NULL,
                                     "triangulation update canceled after %zu of %zu moves", k, nids);
+            // the moved ids jump across the structure (the packer's order): ask the memory
+            // for the vertices, then their faces, a few moves ahead (only a hint)
+            if (k + UPDATE_AHEAD_VERTEX < nids)
+                __builtin_prefetch(&*rt->vertex[ids[k + UPDATE_AHEAD_VERTEX]]);
+            if (k + UPDATE_AHEAD_FACE < nids)
+                __builtin_prefetch(&*rt->vertex[ids[k + UPDATE_AHEAD_FACE]]->face());
             rebuild = move_vertex(*rt, ids[k], weighted(disks[ids[k]]), st) == NEEDS_REBUILD;
         }
         if (rebuild) {
