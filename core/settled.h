@@ -2,7 +2,7 @@
  * step went nowhere (settled, blocked, or without a target) goes nowhere again as long as
  * nothing that step read has changed: its position, its ring and the positions of its ring,
  * and the disks near the positions it tried. Skipping it gives the same sweep, to the bit;
- * at 10^5 to 10^6 grains a fifth to a third of the centres a sweep visits are skipped. */
+ * at 10^5 grains of the variable law a third of the visits are skipped (bench/GEOM_RESULTS.md). */
 #ifndef GRAINPACK_CORE_SETTLED_H
 #define GRAINPACK_CORE_SETTLED_H
 
@@ -50,7 +50,7 @@ int settled_init(settled *s, const gp_grid *grid, double R_max, size_t n);
  * state is known must have been visited in the last sweep (settled_forget the others). */
 void settled_sweep(settled *s);
 
-/* Disk `id` (radius R) moved from (old_x, old_y) to (x, y): the centres whose steps read
+/* Disk `id` moved from (old_x, old_y) to (x, y): the centres whose steps read
  * either position find out in settled_holds. Returns 0 or GP_ENOMEM. */
 int settled_moved(settled *s, int32_t id, double old_x, double old_y, double x, double y);
 
