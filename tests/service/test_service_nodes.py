@@ -126,10 +126,13 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
                 f"A's next page on B: {second}")
         # a long-poll on one node wakes when the other finishes the job: which node claims a
         # job is a race (both hear of it), so the poll goes to the node that does not run it,
-        # parked while the job (about a second of packing) still runs there
+        # parked while the job (some tenths of a second of packing) still runs there. A
+        # wait ends only by its job's end or its deadline: an answer "successful" before the
+        # deadline is the other node's notification (however slow a loaded machine makes
+        # the job itself)
         woke = False
         for attempt in range(5):
-            job = clients[1].submit(gpd.big_spec(side=1000)).json()["jobID"]
+            job = clients[1].submit(gpd.big_spec(side=600)).json()["jobID"]
             runner = ""
             deadline = time.monotonic() + gpd.JOB_LIMIT
             while not runner and time.monotonic() < deadline:
@@ -139,10 +142,10 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
             t0 = time.monotonic()
             if f"job {job} successful" in running_on.log():
                 continue  # it ended before the poll began: that proves nothing, again
-            info = other.get(f"/jobs/{job}?wait=30").json()
+            info = other.get(f"/jobs/{job}?wait=60").json()
             waited = time.monotonic() - t0
             if info["status"] == "successful" and f"job {job} successful" in running_on.log():
-                c.check(waited < 10, f"the long-poll woke {waited:.2f} s after the other node's job began")
+                c.check(waited < 55, f"the long-poll ran to its deadline ({waited:.2f} s)")
                 print(f"a long-poll parked on one node woke {waited:.2f} s after it began, the job "
                       f"run by {runner.split('/')[0]}")
                 woke = True
