@@ -181,19 +181,22 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", bad[i].domain);
         CHECK_STR(err.pointer, bad[i].pointer);
     }
-    /* the stages that do not take a periodic domain yet say so at their own field */
+    /* balancing takes a periodic domain; the mesh, which does not yet, says so at its
+     * own field */
     static const struct {
         const char *stage, *pointer;
-    } stages[] = {{"\"balance\": {\"method\": \"relocation\"}", "/balance"},
-                  {"\"mesh\": {\"element_size\": 1}", "/mesh"}};
+        int rc;
+    } stages[] = {{"\"balance\": {\"method\": \"relocation\"}", "", 0},
+                  {"\"mesh\": {\"element_size\": 1}", "/mesh", GP_EINVAL}};
     for (size_t i = 0; i < sizeof stages / sizeof stages[0]; i++) {
         char json[512];
         snprintf(json, sizeof json,
                  "{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW ", %s}",
                  stages[i].stage);
         gp_error err;
-        CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", stages[i].stage);
-        CHECK_STR(err.pointer, stages[i].pointer);
+        CHECK_MSG(parse_error(json, &err) == stages[i].rc, "%s", stages[i].stage);
+        if (stages[i].rc)
+            CHECK_STR(err.pointer, stages[i].pointer);
     }
     /* a tiled picture needs a periodic domain, and at most GP_PICTURE_MAX_TILE copies */
     static const struct {
