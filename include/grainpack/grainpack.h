@@ -58,6 +58,7 @@
 #include "grainpack/mesh.h"
 #include "grainpack/out.h"
 #include "grainpack/pack.h"
+#include "grainpack/pack3d.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/progress.h"
 #include "grainpack/rng.h"
