@@ -24,12 +24,6 @@
 
 /* ---- radii ---- */
 
-static void draw_radius(p3_packer *pk)
-{
-    pk->pending_r = gp_distribution_sample(pk->params->dist, &pk->rng);
-    pk->pending_R = gp_joint_packing_radius(pk->params->joint, pk->pending_r);
-}
-
 /* The class of radius R: 0 for the smallest radii up to P3_CLASSES - 1 (docs/3d.md §4). */
 static int radius_class(const p3_packer *pk, double R)
 {
@@ -37,6 +31,13 @@ static int radius_class(const p3_packer *pk, double R)
     if (!(c >= 0.0))
         return 0;
     return c >= P3_CLASSES - 1 ? P3_CLASSES - 1 : (int)c;
+}
+
+static void draw_radius(p3_packer *pk)
+{
+    pk->pending_r = gp_distribution_sample(pk->params->dist, &pk->rng);
+    pk->pending_R = gp_joint_packing_radius(pk->params->joint, pk->pending_r);
+    pk->pending_class = radius_class(pk, pk->pending_R);
 }
 
 /* ---- the order (gp_pack3d_order) ---- */
@@ -120,14 +121,20 @@ static int32_t add_sphere(p3_packer *pk, const double p[3], uint32_t level)
 /* Whether a sphere of packing radius R centred at p is inside the box (to GP_CONTACT_RTOL
  * of R: a sphere against a wall is at exactly R from it, up to rounding) and overlaps no
  * sphere. */
-static int fits(const p3_packer *pk, const double p[3], double R)
+static int fits(p3_packer *pk, const double p[3], double R)
 {
     const double side[3] = {pk->box->width, pk->box->height, pk->box->depth};
     double slack = R * GP_CONTACT_RTOL;
     for (int a = 0; a < 3; a++)
         if (!(p[a] - R >= -slack) || !(p[a] + R <= side[a] + slack))
             return 0;
-    return p3_grid_first_overlap(&pk->grid, pk->spheres, p[0], p[1], p[2], R, pk->R_max) == P3_NONE;
+    if (pk->blocker != P3_NONE && p3_overlap(p[0], p[1], p[2], R, &pk->spheres[pk->blocker]))
+        return 0; /* the sphere in the way of the last position tried, often in the way again */
+    int32_t q = p3_grid_first_overlap(&pk->grid, pk->spheres, p[0], p[1], p[2], R, pk->R_max);
+    if (q == P3_NONE)
+        return 1;
+    pk->blocker = q;
+    return 0;
 }
 
 /* ---- the loop (docs/3d.md §4) ---- */
@@ -219,7 +226,7 @@ static int try_triangle(p3_packer *pk, int32_t t)
 static int run(p3_packer *pk)
 {
     for (;;) {
-        int cls = radius_class(pk, pk->pending_R);
+        int cls = pk->pending_class;
         int32_t t = p3_front_pop_retry(&pk->fr, cls);
         if (t == P3_NONE)
             t = p3_front_pop(&pk->fr);
@@ -326,6 +333,7 @@ int gp_pack3d(const gp_pack3d_params *params, const gp_progress *progress, gp_pa
     pk.R_min = R_min;
     pk.R_max = R_max;
     pk.gap = P3_LINK_GAP;
+    pk.blocker = P3_NONE;
     pk.class_scale = R_max > R_min ? P3_CLASSES / log(R_max / R_min) : 0.0;
     gp_rng_seed(&pk.rng, params->seed);
     p3_front_init(&pk.fr);

@@ -106,18 +106,20 @@ void p3_front_retry(p3_front *fr, int32_t t, int cls)
 {
     fr->tris[t].next = fr->retry[cls];
     fr->retry[cls] = t;
+    fr->retrying |= 1u << cls;
 }
 
 int32_t p3_front_pop_retry(p3_front *fr, int cls)
 {
-    for (int k = P3_CLASSES - 1; k > cls; k--) {
-        int32_t t = fr->retry[k];
-        if (t != P3_NONE) {
-            fr->retry[k] = fr->tris[t].next;
-            return t;
-        }
-    }
-    return P3_NONE;
+    uint32_t above = fr->retrying & ~((2u << cls) - 1);
+    if (!above)
+        return P3_NONE;
+    int k = 31 - __builtin_clz(above); /* the largest class first */
+    int32_t t = fr->retry[k];
+    fr->retry[k] = fr->tris[t].next;
+    if (fr->retry[k] == P3_NONE)
+        fr->retrying &= ~(1u << k);
+    return t;
 }
 
 void p3_front_release(p3_front *fr, int32_t t)

@@ -93,6 +93,7 @@ typedef struct p3_front {
     uint32_t low;      /* no waiting triangle has a key below this */
     size_t waiting;    /* triangles in the key buckets */
     int32_t retry[P3_CLASSES]; /* per class: the triangles that failed for it (a stack) */
+    uint32_t retrying;   /* bit k set when retry[k] is not empty */
     uint64_t made;     /* triangles pushed in all */
 } p3_front;
 
@@ -133,6 +134,8 @@ typedef struct p3_packer {
     const gp_progress *progress;
     gp_rng rng;
     double pending_r, pending_R; /* the drawn radius, kept until it is placed */
+    int pending_class;           /* its radius class (P3_CLASSES) */
+    int32_t blocker;             /* the sphere in the way of the last position tested, or P3_NONE */
     gp_sphere *spheres;
     uint32_t *level;             /* per sphere: 0 on a wall, else 1 + the lowest of its three */
     size_t count, capacity;

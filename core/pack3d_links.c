@@ -68,7 +68,7 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
                 }
     for (int w = 0; w < P3_WALLS; w++) {
         double gap = wall_gap(pk, s, w);
-        if (gap < 2.0 * pk->R_max)
+        if (gap < pk->gap * pk->R_max)
             links[n++] = (link){P3_WALL(w), gap};
     }
     return n;
@@ -80,9 +80,9 @@ static int linked(const p3_packer *pk, int32_t a, int32_t b)
     if (P3_IS_WALL(a) && P3_IS_WALL(b))
         return P3_WALL_INDEX(a) / 2 != P3_WALL_INDEX(b) / 2; /* walls across an axis never */
     if (P3_IS_WALL(a))
-        return wall_gap(pk, &pk->spheres[b], P3_WALL_INDEX(a)) < 2.0 * pk->R_max;
+        return wall_gap(pk, &pk->spheres[b], P3_WALL_INDEX(a)) < pk->gap * pk->R_max;
     if (P3_IS_WALL(b))
-        return wall_gap(pk, &pk->spheres[a], P3_WALL_INDEX(b)) < 2.0 * pk->R_max;
+        return wall_gap(pk, &pk->spheres[a], P3_WALL_INDEX(b)) < pk->gap * pk->R_max;
     const gp_sphere *sa = &pk->spheres[a], *sb = &pk->spheres[b];
     double reach = link_reach(pk, sa, sb);
     return dist2(sa, sb) < reach * reach;
@@ -106,47 +106,49 @@ static int32_t behind_of(const p3_packer *pk, int32_t parent, int32_t a, int32_t
     return hits == 2 && third >= 0 ? third : P3_NONE;
 }
 
-/* The links on each side of the plane of c and spheres a and b that are linked to both a
- * and b (tetrahedra c a b s): side[0] one below the plane (or P3_NONE), side[1] one above. */
-static void closing_spheres(const p3_packer *pk, int32_t c, const link *links, int n,
-                            unsigned char adj[][P3_LINKS + P3_WALLS], int i, int j, int32_t side[2])
+/* The links on each side of the plane of c and spheres a and b that are linked to a, b
+ * and c (tetrahedra c a b s), given as the bit mask `common` over links[]: side[0] one
+ * below the plane (or P3_NONE), side[1] one above. */
+static void closing_spheres(const p3_packer *pk, int32_t c, int32_t a, int32_t b, const link *links,
+                            uint32_t common, int32_t side[2])
 {
     side[0] = side[1] = P3_NONE;
-    const gp_sphere *sc = &pk->spheres[c], *sa = &pk->spheres[links[i].id], *sb = &pk->spheres[links[j].id];
+    const gp_sphere *sc = &pk->spheres[c], *sa = &pk->spheres[a], *sb = &pk->spheres[b];
     double u[3] = {sa->x - sc->x, sa->y - sc->y, sa->z - sc->z};
     double v[3] = {sb->x - sc->x, sb->y - sc->y, sb->z - sc->z};
     double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    for (int k = 0; k < n; k++) {
-        if (k == i || k == j || !adj[i][k] || !adj[j][k] || P3_IS_WALL(links[k].id))
-            continue;
-        const gp_sphere *s = &pk->spheres[links[k].id];
+    for (; common; common &= common - 1) {
+        const gp_sphere *s = &pk->spheres[links[__builtin_ctz(common)].id];
         double o = nrm[0] * (s->x - sc->x) + nrm[1] * (s->y - sc->y) + nrm[2] * (s->z - sc->z);
         if (o != 0.0)
-            side[o > 0.0] = links[k].id;
+            side[o > 0.0] = links[__builtin_ctz(common)].id;
     }
 }
 
 int p3_link(p3_packer *pk, int32_t c, int32_t parent)
 {
     link links[P3_LINKS + P3_WALLS];
-    unsigned char adj[P3_LINKS + P3_WALLS][P3_LINKS + P3_WALLS];
+    uint32_t adj[P3_LINKS + P3_WALLS] = {0}, spheres = 0; /* bit masks over links[] */
     int n = gather(pk, c, links);
-    for (int i = 0; i < n; i++)
+    for (int i = 0; i < n; i++) {
+        if (!P3_IS_WALL(links[i].id))
+            spheres |= 1u << i;
         for (int j = i + 1; j < n; j++)
-            adj[i][j] = adj[j][i] = (unsigned char)linked(pk, links[i].id, links[j].id);
+            if (linked(pk, links[i].id, links[j].id)) {
+                adj[i] |= 1u << j;
+                adj[j] |= 1u << i;
+            }
+    }
     for (int i = 0; i < n; i++)
-        for (int j = i + 1; j < n; j++) {
-            if (!adj[i][j])
-                continue;
+        for (uint32_t later = adj[i] & ~((2u << i) - 1); later; later &= later - 1) {
+            int j = __builtin_ctz(later);
             int32_t a = links[i].id, b = links[j].id;
             int32_t behind = behind_of(pk, parent, a, b);
             if (!P3_IS_WALL(a) && !P3_IS_WALL(b)) {
                 int32_t side[2];
-                closing_spheres(pk, c, links, n, adj, i, j, side);
-#ifndef P3_NOSKIP
+                closing_spheres(pk, c, a, b, links, adj[i] & adj[j] & spheres, side);
                 if (side[0] != P3_NONE && side[1] != P3_NONE)
-                    continue; /* a tetrahedron on either side */
-#endif
+                    continue; /* a tetrahedron on either side: closed (docs/3d.md §3) */
                 if (behind == P3_NONE)
                     behind = side[0] != P3_NONE ? side[0] : side[1];
             }

@@ -217,8 +217,8 @@ static void check_law(law3 *law, gp_pack3d_order order, int seeds)
 }
 
 static law3 laws[3] = {
-    {.name = "one radius", .seeds = 2, .side = 8.0, .min_density = 0.46},
-    {.name = "bagi", .seeds = SEEDS, .side = 3.0, .min_density = 0.42},
+    {.name = "one radius", .seeds = 2, .side = 8.0, .min_density = 0.47},
+    {.name = "bagi", .seeds = SEEDS, .side = 4.0, .min_density = 0.46},
     {.name = "iron", .seeds = SEEDS, .side = 64.0, .min_density = 0.46},
 };
 
