@@ -6,19 +6,34 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "bench_util.h"
 #include "grainpack/pack3d.h"
 #include "grainpack/spec.h"
 #include "machine.h"
 
-/* The peak resident set of the process so far, in bytes. */
-static double peak_rss(void)
+/* The peak resident set of the process (VmHWM) in bytes; with reset, first brings the
+ * peak down to the current resident set (Linux's clear_refs "5"). */
+static double peak_rss(int reset)
 {
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_maxrss * 1024.0;
+    if (reset) {
+        FILE *f = fopen("/proc/self/clear_refs", "w");
+        if (f) {
+            fputs("5", f);
+            fclose(f);
+        }
+    }
+    double kb = 0.0;
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmHWM:", 6) == 0)
+            kb = atof(line + 6);
+    if (f)
+        fclose(f);
+    return kb * 1024.0;
 }
 
 static double pack_once(const gp_box *box, const gp_distribution *dist, uint64_t seed,
@@ -63,20 +78,34 @@ static void law_row(const char *name, const gp_distribution *dist, double side, 
     }
 }
 
+/* Runs in a child process of its own, forked before any other packing (so that no freed
+ * heap of the parent's is reused unseen), with the peak resident set reset first. */
 static void scaling_row(const gp_distribution *dist, double target)
 {
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) {
+        perror("fork");
+        exit(1);
+    }
+    if (pid > 0) {
+        int status;
+        waitpid(pid, &status, 0);
+        return;
+    }
     /* one radius 0.5: a box holding `target` spheres at a density of ~0.62 */
     double side = cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.62);
     gp_box box = {side, side, side};
-    double before = peak_rss();
+    double before = peak_rss(1);
     gp_packing3d out;
     double cpu, wall = pack_once(&box, dist, 1, GP_PACK3D_LEVEL, &out, &cpu);
-    double after = peak_rss();
+    double after = peak_rss(0);
     printf("| %.0f | %.2f | %zu | %.4f | %.2f s | %.2f s | %.0f | %.0f | %.0f |\n", target, side, out.count,
            out.fill_volume / (side * side * side), wall, cpu, out.count / wall, out.count / cpu,
            (after - before) / (double)out.count);
     fflush(stdout);
     gp_packing3d_free(&out);
+    _exit(0);
 }
 
 int main(int argc, char **argv)
@@ -102,6 +131,10 @@ int main(int argc, char **argv)
     if (gp_spec_load_file(path, NULL, &iron, &err))
         bench_die(path, &err);
 
+    printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS growth) |\n");
+    printf("|---|---|---|---|---|---|---|---|---|\n");
+    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
+        scaling_row(&one, n);
     printf("\n| law | order | box side | spheres | density (mean +- sd, min-max over %d seeds) | wall | CPU | spheres per CPU s |\n",
            seeds);
     printf("|---|---|---|---|---|---|---|---|\n");
@@ -109,10 +142,6 @@ int main(int argc, char **argv)
     law_row("uniform 0.06-0.42 (3D Bagi)", &bagi, 20 * 0.84, seeds);
     law_row("iron histogram, 2-8 (no joint)", &iron.dist, 20 * 16.0, seeds);
 
-    printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS) |\n");
-    printf("|---|---|---|---|---|---|---|---|---|\n");
-    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
-        scaling_row(&one, n);
     gp_spec_free(&iron);
     return 0;
 }
