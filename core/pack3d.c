@@ -244,28 +244,28 @@ static int run(p3_packer *pk)
     }
 }
 
-/* Checks the parameters: 0, or GP_EINVAL with err set. */
-static int check_params(const gp_pack3d_params *params, double R_min, double R_max, gp_error *err)
+int gp_pack3d_check(const gp_box *b, const gp_distribution *dist, const gp_joint *joint, gp_error *err)
 {
-    const gp_box *b = params->box;
+    double r_min, r_max, R_min, R_max;
+    gp_distribution_support(dist, &r_min, &r_max);
+    gp_joint_packing_range(joint, r_min, r_max, &R_min, &R_max);
     const double side[3] = {b->width, b->height, b->depth};
-    static const char *const names[3] = {"/inputs/domain/width", "/inputs/domain/height",
-                                         "/inputs/domain/depth"};
+    static const char *const names[3] = {"/domain/width", "/domain/height", "/domain/depth"};
     for (int a = 0; a < 3; a++)
         if (!isfinite(side[a]) || !(side[a] > 0.0))
             return gp_error_set(err, GP_EINVAL, names[a], "a box side must be a positive number, got %g",
                                 side[a]);
-    if (params->order != GP_PACK3D_LEVEL && params->order != GP_PACK3D_LOWEST)
-        return gp_error_set(err, GP_EINVAL, NULL, "unknown 3D packing order %d", (int)params->order);
     if (!(R_min > 0.0) || !isfinite(R_max))
-        return gp_error_set(err, GP_EINVAL, "/inputs/distribution",
+        return gp_error_set(err, GP_EINVAL, "/distribution",
                             "packing radii must be positive and finite, got %g to %g", R_min, R_max);
     for (int a = 0; a < 3; a++)
         if (!(side[a] >= 2.0 * R_max))
             return gp_error_set(err, GP_EINVAL, names[a],
-                                "the largest packing sphere (R = %g) does not fit in the box", R_max);
+                                "the largest packing sphere (diameter %g) must fit in the box, whose "
+                                "side is %g",
+                                2.0 * R_max, side[a]);
     if (!(R_max <= GP_PACK3D_MAX_RADIUS_RATIO * R_min))
-        return gp_error_set(err, GP_EINVAL, "/inputs/distribution",
+        return gp_error_set(err, GP_EINVAL, "/distribution",
                             "packing radii from %g to %g span a ratio of %.3g, more than the 3D "
                             "packer's limit of %g: the work to test a position grows with the cube "
                             "of that ratio (docs/3d.md §5)",
@@ -312,12 +312,14 @@ int gp_pack3d(const gp_pack3d_params *params, const gp_progress *progress, gp_pa
               gp_error *err)
 {
     memset(out, 0, sizeof *out);
+    int rc = gp_pack3d_check(params->box, params->dist, params->joint, err);
+    if (rc)
+        return rc;
+    if (params->order != GP_PACK3D_LEVEL && params->order != GP_PACK3D_LOWEST)
+        return gp_error_set(err, GP_EINVAL, NULL, "unknown 3D packing order %d", (int)params->order);
     double r_min, r_max, R_min, R_max;
     gp_distribution_support(params->dist, &r_min, &r_max);
     gp_joint_packing_range(params->joint, r_min, r_max, &R_min, &R_max);
-    int rc = check_params(params, R_min, R_max, err);
-    if (rc)
-        return rc;
     /* sphere ids are int32 */
     gp_pack3d_params capped = *params;
     if (!capped.max_spheres || capped.max_spheres > (size_t)INT32_MAX - 1)

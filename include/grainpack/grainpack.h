@@ -63,6 +63,7 @@
 #include "grainpack/progress.h"
 #include "grainpack/rng.h"
 #include "grainpack/spec.h"
+#include "grainpack/spec3d.h"
 #include "grainpack/stats.h"
 #include "grainpack/triangulation.h"
 #include "grainpack/version.h"

@@ -10,6 +10,7 @@
 #include "grainpack/distribution.h"
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
+#include "grainpack/out.h"
 #include "grainpack/progress.h"
 
 #ifdef __cplusplus
@@ -66,17 +67,28 @@ typedef struct gp_packing3d {
     double fill_volume;   /* sum of 4/3 pi R^3 over the spheres */
 } gp_packing3d;
 
+/* Checks that the law (with `joint`, NULL for none) can be packed in the box: sides
+ * positive and finite, the largest packing sphere inside, the radius ratio at most
+ * GP_PACK3D_MAX_RADIUS_RATIO, every side at most GP_PACK_MAX_SIDE_RADII smallest radii.
+ * Returns 0 or GP_EINVAL with err set, its pointer relative to a spec's inputs
+ * ("/domain/depth", "/distribution"). */
+GP_API int gp_pack3d_check(const gp_box *box, const gp_distribution *dist, const gp_joint *joint,
+                           gp_error *err);
+
 /* Packs the box (docs/3d.md) until the front is empty. On success returns 0 and `out`
- * owns its spheres (free with gp_packing3d_free). On failure returns GP_EINVAL (a box side
- * not finite and positive, a sphere larger than the box, a law outside
- * GP_PACK3D_MAX_RADIUS_RATIO or a side above GP_PACK_MAX_SIDE_RADII smallest radii, an
- * unknown order), GP_ETOOBIG (max_spheres reached, or a grid too large), GP_ENOMEM or
+ * owns its spheres (free with gp_packing3d_free). On failure returns GP_EINVAL (what
+ * gp_pack3d_check refuses, or an unknown order), GP_ETOOBIG (max_spheres reached, or a grid too large), GP_ENOMEM or
  * GP_ECANCELED, sets err, and leaves `out` zeroed. `progress` may be NULL. */
 GP_API int gp_pack3d(const gp_pack3d_params *params, const gp_progress *progress,
                      gp_packing3d *out, gp_error *err);
 
 /* Frees the spheres of a packing and zeroes it (a zeroed one is accepted). */
 GP_API void gp_packing3d_free(gp_packing3d *packing);
+
+/* Writes the packing as CSV, a header then one line per sphere in placement order:
+ * x,y,z,r,R (shortest decimals that read back exactly), and flushes. Returns the gp_out's
+ * error (0 or GP_EIO / GP_ENOMEM). The packing is borrowed. */
+GP_API int gp_write_spheres_csv(gp_out *out, const gp_packing3d *packing);
 
 #ifdef __cplusplus
 }
