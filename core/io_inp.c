@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "grainpack/io_mesh.h"
+#include "writer.h"
 
 /* Abaqus data lines hold at most 16 entries. */
 #define INP_PER_LINE 16
@@ -47,8 +48,9 @@ static int by_value(const void *a, const void *b)
 
 int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
-    if (!result->has_mesh)
-        return GP_EINVAL;
+    int checked = gp_mesh_result_check(result, GP_FORMAT_INP, NULL);
+    if (checked)
+        return checked;
     const gp_mesh *m = &result->mesh;
     const gp_mesh_params *p = &spec->mesh;
     uint64_t *list = malloc(((m->order + 1) * m->nbedges + 1) * sizeof *list);

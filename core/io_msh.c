@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include "grainpack/io_mesh.h"
+#include "writer.h"
 
 /* Gmsh element types (MSH format reference, "elm-type"). */
 #define MSH_LINE2 1
@@ -83,8 +84,9 @@ static void element(gp_out *o, uint64_t *tag, const int32_t *nodes, int n)
 
 int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
-    if (!result->has_mesh)
-        return GP_EINVAL;
+    int checked = gp_mesh_result_check(result, GP_FORMAT_MSH, NULL);
+    if (checked)
+        return checked;
     const gp_mesh *m = &result->mesh;
     size_t nregions = m->ngrains + 1;
     size_t *tri_start = malloc((nregions + 1) * sizeof *tri_start);

@@ -48,6 +48,10 @@ int gp_pslg_seed(gp_pslg *g, double x, double y, int32_t region);
 int gp_pslg_strip(gp_pslg *g, int32_t a0, int32_t a1, int32_t b0, int32_t b1);
 void gp_pslg_free(gp_pslg *g);
 
+/* The graded region's local size is the band's thickness times this: elements about as
+ * long as the band is thick (issue 11), one row of triangles across a strip. */
+#define GP_CDT_GRADED_SIZE_PER_THICKNESS 1.5
+
 typedef struct gp_cdt_params {
     double size_bound;        /* the longest edge allowed (0: none) */
     double shape_bound;       /* sin^2 of the smallest angle allowed (0: none) */

@@ -33,8 +33,8 @@ extern "C" {
  * an outline edge and its arc, relative to the radius (23 edges for a whole circle). */
 #define GP_MESH_DEFAULT_DISK_TOLERANCE 0.01
 /* A mesh may grow to this many times the element cap its spec was checked against
- * before the stage gives up: the estimate (gp_mesh_expected_elements) is good to about a
- * factor of two either way. */
+ * before the stage gives up: the estimate (gp_mesh_expected_elements) was 0.69 to 1.62
+ * times the count made on the reference cases (bench/MESH.md). */
 #define GP_MESH_CAP_SLACK 2
 /* The most layers a spec may ask across a band strip. */
 #define GP_MESH_MAX_BAND_LAYERS 64
@@ -165,10 +165,12 @@ GP_API void gp_mesh_params_default(const gp_distribution *dist, gp_mesh_params *
 /* The mean grain radius of a law. */
 GP_API double gp_mesh_mean_radius(const gp_distribution *dist);
 
-/* An estimate (within a factor of about two) of the elements a mesh with `params` will
- * have, for a structure of `expected_disks` grains of law `dist` with joint `joint` in
- * `domain`, with cells shrunk by `shrink` (`has_cells` 0: disks in a matrix). Used to
- * refuse specs over a cap before any work. */
+/* An estimate of the elements a mesh with `params` will have (0.69 to 1.62 times the
+ * count made on the reference cases, seeds and options of bench/MESH.md;
+ * tests/test_mesh_estimate.c holds it within 0.6 to 1.7), for a structure of
+ * `expected_disks` grains of law `dist` with joint `joint` in `domain`, with cells shrunk
+ * by `shrink` (`has_cells` 0: disks in a matrix). Used to refuse specs over a cap before
+ * any work. */
 GP_API double gp_mesh_expected_elements(const gp_domain *domain, const gp_distribution *dist,
                                         const gp_joint *joint, double expected_disks, int has_cells,
                                         gp_shrink shrink, const gp_mesh_params *params);
