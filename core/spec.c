@@ -755,8 +755,8 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
         return GP_EINVAL;
     }
     /* the stages that do not take a periodic domain yet (docs/method.md §3.8) */
-    static const char *const walled_only[] = {"balance", "mesh"};
-    int enabled[] = {spec->balance_enabled, spec->mesh_enabled};
+    static const char *const walled_only[] = {"balance"};
+    int enabled[] = {spec->balance_enabled};
     for (size_t k = 0; k < sizeof enabled / sizeof enabled[0]; k++)
         if (spec->domain.periodic && enabled[k]) {
             char stage_ptr[GP_ERROR_POINTER_MAX];
@@ -777,6 +777,14 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
         return 0;
     char size_ptr[GP_ERROR_POINTER_MAX], mesh_ptr[GP_ERROR_POINTER_MAX];
     pointer_key(mesh_ptr, base, "mesh");
+    if (spec->domain.periodic && spec->mesh.band_layers > 0) {
+        char layers_ptr[GP_ERROR_POINTER_MAX];
+        pointer_key(layers_ptr, mesh_ptr, "band_layers");
+        return gp_error_set(v->err, GP_EINVAL, layers_ptr,
+                            "is not available on a periodic domain (the band's strips would be "
+                            "cut by the periodic sides); leave it out: the band is then meshed "
+                            "with triangles");
+    }
     pointer_key(size_ptr, mesh_ptr, "element_size");
     spec->expected_elements = gp_mesh_expected_elements(
         &spec->domain, &spec->dist, &spec->joint, spec->expected_disks, spec->laguerre_enabled,
