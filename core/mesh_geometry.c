@@ -120,6 +120,7 @@ static int collect_cells(builder *b)
 
 typedef struct contact {
     double angle, x, y, min_step; /* min_step: of the outline edges on either side */
+    int crossing;                 /* a crossing of a periodic side's line (side_crossings) */
 } contact;
 
 static int by_angle(const void *a, const void *b)
@@ -166,8 +167,29 @@ static int add_contact(contact **list, size_t *n, size_t *cap, double angle, dou
         return GP_ENOMEM;
     if (angle < 0.0)
         angle += 2.0 * M_PI;
-    (*list)[(*n)++] = (contact){angle, x, y, min_step};
+    (*list)[(*n)++] = (contact){angle, x, y, min_step, 0};
     return 0;
+}
+
+/* Drops the crossings of a side's line that lie closer to a contact (around the circle)
+ * than the contact's minimum step: the outline's edge from the contact then spans its
+ * wedge angle and is cut by the line where it crosses it (a crossing point kept there
+ * would make the two touching outlines' edges a cusp of matrix as thin as their gap). */
+static void drop_crowded_crossings(contact *list, size_t *n)
+{
+    size_t w = 0;
+    for (size_t k = 0; k < *n; k++) {
+        int keep = 1;
+        for (size_t c = 0; c < *n && keep && list[k].crossing; c++) {
+            if (list[c].crossing)
+                continue;
+            double gap = fabs(list[k].angle - list[c].angle);
+            keep = fmin(gap, 2.0 * M_PI - gap) >= list[c].min_step;
+        }
+        if (keep)
+            list[w++] = list[k];
+    }
+    *n = w;
 }
 
 /* The contacts of disk i with the walls (the sides along walled axes). */
@@ -219,6 +241,8 @@ static int side_crossings(builder *b, const gp_disk *d, double near, double step
                     p[axis] = lines[k];
                     p[1 - axis] = c1 + (axis == 0 ? 1.0 : -1.0) * sgn * (off > 0.0 ? 1.0 : -1.0) * chord;
                     rc |= add_contact(list, n, cap, a, p[0], p[1], step);
+                    if (rc == 0)
+                        (*list)[*n - 1].crossing = 1;
                 }
             }
         }
@@ -273,6 +297,7 @@ static int collect_disks(builder *b, const gp_progress *progress)
                      ? oom(b) : 0;
         if (rc)
             break;
+        drop_crowded_crossings(list, &nlist);
         if (nlist == 0) {
             int m = (int)ceil(2.0 * M_PI / step - 1e-9);
             m = m < 3 ? 3 : m;
