@@ -556,8 +556,9 @@ const int MAX_ROUNDS = 6;
 // first's splits, after which each further round adds about one node per sharp corner
 // where a grain's outline crosses a periodic side at a small angle (the clusters there
 // are never done, and each round splits their shells once more), and never matches. On
-// the periodic iron mesh (bench/PERIODIC.md) locking at round 3 leaves 26 refused
-// refinements where locking at round 6 leaves 24, and 137,406 triangles, not 138,544.
+// the periodic iron mesh (bench/PERIODIC.md, seeds 1-3) locking at round 3 leaves 19 to
+// 30 refused refinements, at round 6 18 to 34 with 1% more triangles, at round 2 739 to
+// 831 (the mirrored nodes' neighbourhoods not yet refined).
 const int MAX_PAIR_ROUNDS = 3;
 // A node of a strip's side is one of the facing side's when their positions along the
 // side (from 0 to 1) differ by less than this: both come from the same halvings of the

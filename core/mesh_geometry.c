@@ -355,6 +355,28 @@ static int collect_periodic_disks(builder *b, const gp_progress *progress)
 
 /* ---- periodic domains: the outlines cut into pieces ---- */
 
+/* Puts the outline vertices within GP_MESH_SIDE_SNAP_RTOL mean radii of a periodic side's
+ * line on it (docs/method.md §7.2). */
+static void snap_to_sides(builder *b)
+{
+    double R_sum = 0.0;
+    for (size_t i = 0; i < b->in->ndisks; i++)
+        R_sum += b->in->disks[i].R;
+    double eps = GP_MESH_SIDE_SNAP_RTOL * (b->in->ndisks ? R_sum / (double)b->in->ndisks : 0.0);
+    for (int axis = 0; axis < 2; axis++) {
+        if (!(b->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)))
+            continue;
+        double period = axis == 0 ? b->W : b->H;
+        for (size_t k = 0; k < b->nraw; k++) {
+            double *c = &b->raw[2 * k + axis];
+            if (fabs(*c) <= eps)
+                *c = 0.0;
+            else if (fabs(*c - period) <= eps)
+                *c = period;
+        }
+    }
+}
+
 /* Each outline (unwrapped: it may cross the periodic sides) replaced by its pieces in
  * the domain: the parts of the outline inside the domain's translates by a period along
  * the periodic axes, each clipped in unwrapped coordinates (so that the two sides of a
@@ -362,6 +384,7 @@ static int collect_periodic_disks(builder *b, const gp_progress *progress)
  * than the weld tolerance is left out: its points would weld onto the side. */
 static int cut_pieces(builder *b)
 {
+    snap_to_sides(b);
     size_t npoly = b->npoly, most = 0;
     size_t *pstart = b->pstart;
     int32_t *region = b->region;

@@ -36,6 +36,15 @@ extern "C" {
  * before the stage gives up: the estimate (gp_mesh_expected_elements) is good to about a
  * factor of two either way. */
 #define GP_MESH_CAP_SLACK 2
+/* Periodic domains: an outline vertex closer than this times the mean packing radius to
+ * a periodic side's line is put on it before the outlines are cut into pieces. Why: a
+ * vertex a little off the line leaves a sliver of band (or grain) as thin as its
+ * distance to the line, opening at the small angle of the vertex's edges, which Delaunay
+ * refinement can only fill with a cascade of tiny elements (a vertex 2e-4 R from the
+ * line made 110,000 extra nodes on the periodic iron mesh); on the line, it is an input
+ * corner, which CGAL's clusters handle. The outline moves by less than the polygonised
+ * disks' own tolerance (GP_MESH_DEFAULT_DISK_TOLERANCE), and only at such vertices. */
+#define GP_MESH_SIDE_SNAP_RTOL 0.01
 /* The most layers a spec may ask across a band strip. */
 #define GP_MESH_MAX_BAND_LAYERS 64
 
