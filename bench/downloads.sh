@@ -36,10 +36,12 @@ job=$(curl -s -o /dev/null -w '%header{location}' -H 'Content-Type: application/
   "$base/processes/pack2d/execution")
 until curl -s "$base$job?wait=60" | grep -qE '"status":"(successful|failed|dismissed)"'; do :; done
 t1=$(date +%s.%N)
+rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
+sleep 1  # the worker's trim of malloc's arenas, once the job is stored
+after_job=$(rss VmRSS)
 curl -s "$base$job" | grep -q '"status":"successful"' || { echo "the job failed"; exit 1; }
 grains=$(curl -s "$base$job/statistics" | python3 -c "import json,sys; print(json.load(sys.stdin)['count'])")
 runs_before=$(curl -s "$base/metrics" | awk '$1 == "grainpack_pipeline_runs_total" {print $2}')
-rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
 
 median() { sort -g | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'; }
 # one download: "ttfb total bytes" (curl's own clock)
@@ -84,6 +86,7 @@ fi
 runs_after=$(curl -s "$base/metrics" | awk '$1 == "grainpack_pipeline_runs_total" {print $2}')
 echo
 python3 -c "print(f'job: {$grains} grains, {$t1 - $t0:.1f} s from submission to successful;'
+                  f' daemon RSS {$after_job / 1024:.1f} MB idle once it was stored;'
                   f' pipeline runs {${runs_before:-0}} before the downloads, {${runs_after:-0}} after')"
 echo "load average $load_start at the start, $(cut -d' ' -f1 /proc/loadavg) at the end;" \
   "$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
