@@ -750,14 +750,6 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
             spec_smallest_radius_pointer(base, &spec->dist, v->err->pointer);
         return GP_EINVAL;
     }
-    /* the mesh does not take a periodic domain yet (docs/method.md §3.8) */
-    if (spec->domain.periodic && spec->mesh_enabled) {
-        char stage_ptr[GP_ERROR_POINTER_MAX];
-        spec_pointer_key(stage_ptr, base, "mesh");
-        return gp_error_set(v->err, GP_EINVAL, stage_ptr,
-                            "does not take a periodic domain yet; leave it out, or give the "
-                            "domain walls (no \"periodic\")");
-    }
     spec->expected_disks = gp_spec_expected_disks(&spec->domain, &spec->dist, &spec->joint);
     double bound = gp_spec_disk_bound(&spec->domain, &spec->dist, &spec->joint);
     if (!(bound <= (double)v->max_disks))
@@ -770,6 +762,14 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
         return 0;
     char size_ptr[GP_ERROR_POINTER_MAX], mesh_ptr[GP_ERROR_POINTER_MAX];
     spec_pointer_key(mesh_ptr, base, "mesh");
+    if (spec->domain.periodic && spec->mesh.band_layers > 0) {
+        char layers_ptr[GP_ERROR_POINTER_MAX];
+        spec_pointer_key(layers_ptr, mesh_ptr, "band_layers");
+        return gp_error_set(v->err, GP_EINVAL, layers_ptr,
+                            "is not available on a periodic domain (the band's strips would be "
+                            "cut by the periodic sides); leave it out: the band is then meshed "
+                            "with triangles");
+    }
     spec_pointer_key(size_ptr, mesh_ptr, "element_size");
     spec->expected_elements = gp_mesh_expected_elements(
         &spec->domain, &spec->dist, &spec->joint, spec->expected_disks, spec->laguerre_enabled,

@@ -181,13 +181,16 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", bad[i].domain);
         CHECK_STR(err.pointer, bad[i].pointer);
     }
-    /* balancing takes a periodic domain; the mesh, which does not yet, says so at its
-     * own field */
+    /* balancing and the mesh take a periodic domain; the mesh's band layers, which do
+     * not, say so at their own field */
     static const struct {
         const char *stage, *pointer;
         int rc;
     } stages[] = {{"\"balance\": {\"method\": \"relocation\"}", "", 0},
-                  {"\"mesh\": {\"element_size\": 1}", "/mesh", GP_EINVAL}};
+                  {"\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"element_size\": 1}", "", 0},
+                  /* the band's strips would be cut by the periodic sides */
+                  {"\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 2}",
+                   "/mesh/band_layers", GP_EINVAL}};
     for (size_t i = 0; i < sizeof stages / sizeof stages[0]; i++) {
         char json[512];
         snprintf(json, sizeof json,
@@ -212,10 +215,12 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", json);
         CHECK_STR(err.pointer, "/picture/tile");
     }
-    /* the cells do take it (test_laguerre checks them) */
+    /* the cells and the mesh do take it (test_laguerre and test_mesh check them) */
     gp_error err;
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW
                       ", \"laguerre\": {\"shrink\": \"offset\"}}", &err) == 0);
+    CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": [\"x\"]}, " LAW
+                      ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {}}", &err) == 0);
     /* along a walled axis the short side is the walled rule's: one disk must fit */
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 2.5, \"periodic\": [\"x\"]}, " LAW "}",
                       &err) == 0);
