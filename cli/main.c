@@ -8,6 +8,7 @@
 #include "grainpack/io.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
+#include "grainpack/spec3d.h"
 #include "grainpack/version.h"
 
 /* Exit statuses, documented in usage(). */
@@ -15,9 +16,10 @@ enum { EXIT_OK = 0, EXIT_FAILED = 1, EXIT_USAGE = 2, EXIT_BAD_SPEC = 3 };
 
 static void usage(FILE *out)
 {
-    fputs("Usage: grainpack run SPEC.json [--format FORMAT] [-o FILE] [--max-disks N]\n"
+    fputs("Usage: grainpack run SPEC.json [--process PROCESS] [--format FORMAT] [-o FILE]\n"
+          "                     [--max-disks N] [--max-elements N]\n"
+          "  or:  grainpack validate SPEC.json [--process PROCESS] [--max-disks N]\n"
           "                     [--max-elements N]\n"
-          "  or:  grainpack validate SPEC.json [--max-disks N] [--max-elements N]\n"
           "  or:  grainpack --help | --version\n"
           "\n"
           "  run       packs the domain the spec describes, balances it, builds its\n"
@@ -28,12 +30,16 @@ static void usage(FILE *out)
           "            inputs object; '-' reads stdin.\n"
           "  validate  checks a spec and prints the expected number of disks.\n"
           "\n"
+          "  --process PROCESS    pack2d (disks in a rectangle) or pack3d (spheres in a box,\n"
+          "                       docs/3d.md); by default pack3d when the spec's domain has\n"
+          "                       a \"depth\", else pack2d. pack3d packs and writes CSV\n"
+          "                       (x,y,z,r,R) only, for now\n"
           "  -f, --format FORMAT  json (default), csv, svg, vtk (legacy VTK), or\n"
           "                       vtu (VTK XML: the mesh, else the grains), msh (Gmsh 4.1),\n"
           "                       inp (Abaqus); msh and inp need \"mesh\" in the spec\n"
           "  -o FILE              write to FILE instead of standard output\n"
-          "  --max-disks N        refuse specs expected to need more than N disks\n"
-          "                       (default 20000000)\n"
+          "  --max-disks N        refuse specs expected to need more than N disks (or\n"
+          "                       spheres; default 20000000)\n"
           "  --max-elements N     refuse meshes expected to need more than N elements,\n"
           "                       and stop a mesh that grows beyond (default 20000000)\n"
           "\n"
@@ -58,27 +64,146 @@ static void show_progress(void *ctx, const char *stage, double fraction)
     fflush(stderr);
 }
 
-static int load_spec(const char *path, size_t max_disks, size_t max_elements, gp_spec *spec)
+/* What a spec failure exits with, after saying why. */
+static int spec_failure(const char *path, int rc, const gp_error *err)
+{
+    if (err->pointer[0])
+        fprintf(stderr, "grainpack: %s: %s: %s\n", path, err->pointer, err->message);
+    else
+        fprintf(stderr, "grainpack: %s: %s\n", path, err->message);
+    return rc == GP_EIO || rc == GP_ENOMEM ? EXIT_FAILED : EXIT_BAD_SPEC;
+}
+
+/* The spec's text ('-': standard input) in a new buffer (the caller frees it): 0 or an
+ * exit status. */
+static int read_spec(const char *path, char **text, size_t *len)
+{
+    gp_error err;
+    gp_error_clear(&err);
+    int rc = gp_spec_read_text(strcmp(path, "-") == 0 ? "/dev/stdin" : path, text, len, &err);
+    return rc ? spec_failure(path, rc, &err) : 0;
+}
+
+/* The process the spec asks for: `forced` when given (-1: none), else by its domain. */
+static gp_process spec_process(const char *text, size_t len, int forced)
+{
+    return forced >= 0 ? (gp_process)forced : gp_spec_process(text, len);
+}
+
+
+/* A spec file's name and its text, read once (standard input cannot be read twice). */
+typedef struct spec_text {
+    const char *path;
+    char *text;
+    size_t len;
+} spec_text;
+
+static int load_spec(const spec_text *st, size_t max_disks, size_t max_elements, gp_spec *spec)
 {
     gp_spec_limits limits = {.max_disks = max_disks, .max_elements = max_elements};
     gp_error err;
     gp_error_clear(&err);
-    int rc = strcmp(path, "-") == 0 ? gp_spec_load_file("/dev/stdin", &limits, spec, &err)
-                                    : gp_spec_load_file(path, &limits, spec, &err);
-    if (rc == 0)
-        return 0;
-    if (err.pointer[0])
-        fprintf(stderr, "grainpack: %s: %s: %s\n", path, err.pointer, err.message);
-    else
-        fprintf(stderr, "grainpack: %s: %s\n", path, err.message);
-    return rc == GP_EIO || rc == GP_ENOMEM ? EXIT_FAILED : EXIT_BAD_SPEC;
+    int rc = gp_spec_parse(st->text, st->len, &limits, spec, &err);
+    return rc ? spec_failure(st->path, rc, &err) : 0;
 }
 
-static int run(const char *spec_path, gp_format format, const char *out_path, size_t max_disks,
+static int load_spec3d(const spec_text *st, size_t max_disks, gp_spec3d *spec)
+{
+    gp_spec_limits limits = {.max_disks = max_disks};
+    gp_error err;
+    gp_error_clear(&err);
+    int rc = gp_spec3d_parse(st->text, st->len, &limits, spec, &err);
+    return rc ? spec_failure(st->path, rc, &err) : 0;
+}
+
+/* Opens the output (NULL path: standard output), or says why not and returns NULL. */
+static FILE *open_output(const char *out_path)
+{
+    FILE *out = out_path ? fopen(out_path, "wb") : stdout;
+    if (!out)
+        fprintf(stderr, "grainpack: cannot write %s: %s\n", out_path, strerror(errno));
+    return out;
+}
+
+/* Writes to out_path (NULL: standard output) with `write`, which returns 0 or a GP_E code;
+ * on any failure says so and removes the file. Returns an exit status. */
+static int write_output(const char *out_path, int (*write)(gp_out *sink, const void *ctx), const void *ctx)
+{
+    FILE *out = open_output(out_path);
+    if (!out)
+        return EXIT_FAILED;
+    gp_out sink;
+    int rc = gp_out_init_file(&sink, out);
+    if (rc == 0)
+        rc = write(&sink, ctx);
+    gp_out_free(&sink);
+    if (out_path && fclose(out) != 0)
+        rc = GP_EIO;
+    else if (!out_path && fflush(out) != 0)
+        rc = GP_EIO;
+    if (!rc)
+        return EXIT_OK;
+    fprintf(stderr, "grainpack: writing %s failed: %s\n", out_path ? out_path : "stdout", gp_strerror(rc));
+    if (out_path)
+        remove(out_path);
+    return EXIT_FAILED;
+}
+
+static int write_spheres(gp_out *sink, const void *packing)
+{
+    return gp_write_spheres_csv(sink, packing);
+}
+
+/* What the 2D run writes. */
+typedef struct result_output {
+    gp_format format;
+    const gp_spec *spec;
+    const gp_result *result;
+} result_output;
+
+static int write_result(gp_out *sink, const void *ctx)
+{
+    const result_output *what = ctx;
+    return gp_write_result(sink, what->format, what->spec, what->result);
+}
+
+/* The 3D process (docs/3d.md): packs the box and writes the spheres as CSV. */
+static int run3d(const spec_text *st, const char *out_path, size_t max_disks)
+{
+    gp_spec3d spec;
+    int status = load_spec3d(st, max_disks, &spec);
+    if (status)
+        return status;
+    terminal_progress tp = {-1};
+    gp_progress progress = {show_progress, &tp, NULL};
+    int tty = isatty(STDERR_FILENO);
+    gp_pack3d_params params = gp_spec3d_pack_params(&spec, max_disks ? max_disks : GP_SPEC_DEFAULT_MAX_DISKS);
+    gp_packing3d packing;
+    gp_error err;
+    gp_error_clear(&err);
+    int rc = gp_pack3d(&params, tty ? &progress : NULL, &packing, &err);
+    if (tty)
+        fputs("\r          \r", stderr);
+    if (rc) {
+        fprintf(stderr, "grainpack: %s: %s\n", st->path, err.message);
+        gp_spec3d_free(&spec);
+        return EXIT_FAILED;
+    }
+    if (tty)
+        fprintf(stderr, "grainpack: %zu spheres, packing density %.4f\n", packing.count,
+                packing.fill_volume / (spec.box.width * spec.box.height * spec.box.depth));
+    status = write_output(out_path, write_spheres, &packing);
+    gp_packing3d_free(&packing);
+    gp_spec3d_free(&spec);
+    return status;
+}
+
+static int run(const spec_text *st, gp_format format, const char *out_path, size_t max_disks,
                size_t max_elements)
 {
+    const char *spec_path = st->path;
     gp_spec spec;
-    int status = load_spec(spec_path, max_disks, max_elements, &spec);
+    int status = load_spec(st, max_disks, max_elements, &spec);
     if (status)
         return status;
     if (gp_format_needs_mesh(format) && !spec.mesh_enabled) {
@@ -123,37 +248,29 @@ static int run(const char *spec_path, gp_format format, const char *out_path, si
                     1e3 * gp_result_stage_seconds(&result, "mesh"));
     }
 
-    FILE *out = out_path ? fopen(out_path, "wb") : stdout;
-    if (!out) {
-        fprintf(stderr, "grainpack: cannot write %s: %s\n", out_path, strerror(errno));
-        status = EXIT_FAILED;
-    } else {
-        gp_out sink;
-        rc = gp_out_init_file(&sink, out);
-        if (rc == 0)
-            rc = gp_write_result(&sink, format, &spec, &result);
-        gp_out_free(&sink);
-        if (out_path && fclose(out) != 0)
-            rc = GP_EIO;
-        else if (!out_path && fflush(out) != 0)
-            rc = GP_EIO;
-        if (rc) {
-            fprintf(stderr, "grainpack: writing %s failed: %s\n", out_path ? out_path : "stdout",
-                    gp_strerror(rc));
-            if (out_path)
-                remove(out_path);
-            status = EXIT_FAILED;
-        }
-    }
+    result_output what = {format, &spec, &result};
+    status = write_output(out_path, write_result, &what);
     gp_result_free(&result);
     gp_spec_free(&spec);
     return status;
 }
 
-static int validate(const char *spec_path, size_t max_disks, size_t max_elements)
+static int validate3d(const spec_text *st, size_t max_disks)
 {
+    gp_spec3d spec;
+    int status = load_spec3d(st, max_disks, &spec);
+    if (status)
+        return status;
+    printf("%s: valid (pack3d), about %.0f spheres expected\n", st->path, spec.expected_spheres);
+    gp_spec3d_free(&spec);
+    return EXIT_OK;
+}
+
+static int validate(const spec_text *st, size_t max_disks, size_t max_elements)
+{
+    const char *spec_path = st->path;
     gp_spec spec;
-    int status = load_spec(spec_path, max_disks, max_elements, &spec);
+    int status = load_spec(st, max_disks, max_elements, &spec);
     if (status)
         return status;
     printf("%s: valid, about %.0f disks expected", spec_path, spec.expected_disks);
@@ -191,6 +308,7 @@ int main(int argc, char **argv)
     }
     const char *command = argv[1], *spec_path = NULL, *out_path = NULL;
     gp_format format = GP_FORMAT_JSON;
+    int format_given = 0, process = -1;
     size_t max_disks = 0, max_elements = 0;
     if (strcmp(command, "run") != 0 && strcmp(command, "validate") != 0) {
         fprintf(stderr, "grainpack: unknown command '%s'\n", command);
@@ -204,6 +322,17 @@ int main(int argc, char **argv)
             if (gp_format_parse(value, &format)) {
                 fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg, vtk, vtu, msh "
                                 "or inp)\n", value);
+                return EXIT_USAGE;
+            }
+            format_given = 1;
+            i++;
+        } else if (strcmp(arg, "--process") == 0 && value) {
+            if (strcmp(value, "pack2d") == 0) {
+                process = GP_PROCESS_PACK2D;
+            } else if (strcmp(value, "pack3d") == 0) {
+                process = GP_PROCESS_PACK3D;
+            } else {
+                fprintf(stderr, "grainpack: unknown process '%s' (expected pack2d or pack3d)\n", value);
                 return EXIT_USAGE;
             }
             i++;
@@ -236,7 +365,20 @@ int main(int argc, char **argv)
         usage(stderr);
         return EXIT_USAGE;
     }
-    if (strcmp(command, "validate") == 0)
-        return validate(spec_path, max_disks, max_elements);
-    return run(spec_path, format, out_path, max_disks, max_elements);
+    spec_text st = {spec_path, NULL, 0};
+    int status = read_spec(spec_path, &st.text, &st.len);
+    if (status)
+        return status;
+    int is3d = spec_process(st.text, st.len, process) == GP_PROCESS_PACK3D;
+    if (is3d && strcmp(command, "run") == 0 && format_given && format != GP_FORMAT_CSV) {
+        fprintf(stderr, "grainpack: the pack3d process writes csv only for now, not %s\n",
+                gp_format_name(format));
+        status = EXIT_USAGE;
+    } else if (strcmp(command, "validate") == 0) {
+        status = is3d ? validate3d(&st, max_disks) : validate(&st, max_disks, max_elements);
+    } else {
+        status = is3d ? run3d(&st, out_path, max_disks) : run(&st, format, out_path, max_disks, max_elements);
+    }
+    free(st.text);
+    return status;
 }

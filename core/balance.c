@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "nearby.h"
+#include "periodic.h"
 #include "quality.h"
 #include "rings.h"
 #include "settled.h"
@@ -31,6 +32,17 @@
  * outside is tested against the grid cells around it instead (the same answer, slower). */
 #define BOX_MARGIN_RTOL 1e-6
 
+/* On a periodic domain with GP_RT_UPDATE_FLIPS the ghosts follow their disks and the
+ * layer is made again, centres wrapped, before a sweep once some disk has moved this
+ * share of the margin away from where the layer was made: the images present are then
+ * still those within 3/4 of the margin, 4.5 largest radii at the first margin, well past
+ * the power circles of a dense packing's cells and the reach of a centre's moves. */
+#define LAYER_DRIFT_SHARE 0.25
+
+/* measure's answer when a cell on a periodic domain may miss a neighbour beyond the
+ * ghosts: the layer must be made again with a wider margin. */
+#define LAYER_TOO_THIN 1
+
 const char *gp_balance_method_name(gp_balance_method method)
 {
     switch (method) {
@@ -44,13 +56,17 @@ const char *gp_balance_method_name(gp_balance_method method)
 /* Everything one balancing run works with. */
 typedef struct balancer {
     const gp_domain *domain;
-    gp_disk *disks;
-    size_t n;
+    gp_disk *disks;     /* the caller's disks, or on a periodic domain layer.all */
+    size_t n;           /* the disks balanced: the caller's */
+    size_t m;           /* the triangulation's vertices: n, or n and the ghosts */
+    gp_rt *rt;          /* the caller's triangulation, or the layer's */
+    quality_frame frame;
     gp_balance_method method;
     double max_step;
     rings rings;        /* the rings of the structure the sweep starts from */
     nearby near;        /* the disks near the positions a centre tries */
-    settled settled;    /* the centres whose last step still holds */
+    settled settled;    /* the centres whose last step still holds (walled domains) */
+    int remember;       /* whether `settled` is kept: walled domains only */
     double *F;          /* F of the structure the sweep starts from (NAN: not interior);
                            the result's array, which holds F of the best one at the end */
     uint8_t *changed;   /* rings the last update changed (gp_rt_mark_changes) */
@@ -62,6 +78,15 @@ typedef struct balancer {
     int32_t *moved;     /* ids moved in the current sweep, or restored at the end */
     size_t nmoved;
     double *best;       /* x, y of every centre in the best structure seen */
+    /* periodic domains (docs/method.md §4.7): the sweeps work on the disks and their
+     * ghosts, each ghost moved with its disk */
+    gp_disk *user;      /* the caller's disks, written back wrapped at each new layer */
+    periodic_layer layer;
+    gp_domain grid_domain; /* nearby's grid: the walled rectangle, ghosts in its edge cells */
+    double *anchor;     /* x, y of each disk when the layer was made */
+    double drift;       /* the farthest a disk has moved since */
+    double margin;      /* the margin of the next layer */
+    double R_max;
 } balancer;
 
 /* Gathers the disks that may overlap the packing disk of `id` placed anywhere in the box
@@ -72,12 +97,26 @@ static int gather(balancer *b, int32_t id, double x0, double y0, double x1, doub
     return nearby_gather(&b->near, b->disks, id, R, x0, y0, x1, y1, BOX_MARGIN_RTOL * R);
 }
 
+/* Whether every disk that could overlap a disk of radius R at (x, y) has its images in
+ * the layer (periodic domains): the disks within R + R_max, along the periodic axes,
+ * inside the box of the ghosts less the drift (quality_frame). */
+static int within_layer(const balancer *b, double x, double y, double R)
+{
+    double reach = R + b->R_max, box = b->frame.box;
+    return (!(b->domain->periodic & GP_PERIODIC_X) ||
+            (x - reach > -box && x + reach < b->domain->width + box)) &&
+           (!(b->domain->periodic & GP_PERIODIC_Y) ||
+            (y - reach > -box && y + reach < b->domain->height + box));
+}
+
 /* Whether the packing disk of `id` may sit at (x, y): inside the domain and clear of
- * every other disk, with the packer's contact tolerance. */
+ * every other disk (on a periodic domain, every image), with the packer's contact
+ * tolerance. */
 static int position_is_free(balancer *b, int32_t id, double x, double y)
 {
     double R = b->disks[id].R;
     return gp_domain_contains_disk(b->domain, x, y, R, R * GP_CONTACT_RTOL) &&
+           (!b->domain->periodic || within_layer(b, x, y, R)) &&
            nearby_is_clear(&b->near, b->disks, id, R, x, y);
 }
 
@@ -157,7 +196,7 @@ static int step_centre(balancer *b, int32_t id, const int32_t *ring, size_t degr
         p->x = x;
         p->y = y;
         nearby_move(&b->near, b->disks, id, old_x, old_y);
-        return settled_moved(&b->settled, id, old_x, old_y, x, y) ? GP_ENOMEM : 1;
+        return b->remember && settled_moved(&b->settled, id, old_x, old_y, x, y) ? GP_ENOMEM : 1;
     }
     (*refused)++;
     return 0;
@@ -171,8 +210,28 @@ static int inside_now(const balancer *b, int32_t i, const int32_t *ring, size_t 
 {
     for (size_t k = 0; k < degree; k++)
         if (b->moved_in[ring[k]] == b->sweep)
-            return quality_cell_inside(b->domain, b->disks, i, ring, degree);
+            return quality_cell_inside(&b->frame, b->disks, i, ring, degree) == 1;
     return !isnan(b->F[i]);
+}
+
+/* Puts the ghosts of disk i, which moved, at its new images, and counts how far it is
+ * from where the layer was made. */
+static void move_ghosts(balancer *b, int32_t i)
+{
+    const periodic_layer *L = &b->layer;
+    for (size_t k = L->ghost_start[i]; k < L->ghost_start[i + 1]; k++) {
+        int32_t g = L->ghost_ids[k];
+        double old_x = b->disks[g].x, old_y = b->disks[g].y;
+        periodic_ghost_place(L, b->domain, g);
+        nearby_move(&b->near, b->disks, g, old_x, old_y);
+        b->moved[b->nmoved++] = g;
+        b->moved_in[g] = b->sweep;
+    }
+    double d = hypot(b->disks[i].x - b->anchor[2 * i], b->disks[i].y - b->anchor[2 * i + 1]);
+    if (d > b->drift) {
+        b->drift = d;
+        b->frame.box = b->layer.margin - d;
+    }
 }
 
 static int report(const gp_progress *progress, double fraction, gp_error *err)
@@ -190,6 +249,8 @@ static int report(const gp_progress *progress, double fraction, gp_error *err)
  * (settled.h): 1 if it moved, 0 if not, or GP_ENOMEM. */
 static int visit(balancer *b, int32_t id, const int32_t *ring, size_t degree, uint64_t *refused)
 {
+    if (!b->remember)
+        return step_centre(b, id, ring, degree, refused);
     int held = settled_holds(&b->settled, b->disks, id, b->disks[id].R);
     if (held != SETTLED_UNKNOWN) {
         *refused += held == SETTLED_REFUSED;
@@ -231,7 +292,8 @@ static void prefetch_visit(const balancer *b, size_t i)
         for (size_t k = 0; k < degree; k++)
             __builtin_prefetch(&b->disks[ring[k]]);
         nearby_prefetch_cells(&b->near, b->disks[j].x, b->disks[j].y);
-        settled_prefetch(&b->settled, b->disks[j].x, b->disks[j].y);
+        if (b->remember)
+            settled_prefetch(&b->settled, b->disks[j].x, b->disks[j].y);
     }
     if (i + AHEAD_ENTRIES < b->n)
         nearby_prefetch_entries(&b->near, b->disks[i + AHEAD_ENTRIES].x, b->disks[i + AHEAD_ENTRIES].y);
@@ -243,7 +305,8 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
                  gp_balance_result *out, gp_error *err)
 {
     b->nmoved = 0;
-    settled_sweep(&b->settled);
+    if (b->remember)
+        settled_sweep(&b->settled);
     for (size_t i = 0; i < b->n; i++) {
         if (i % CENTRES_PER_REPORT == CENTRES_PER_REPORT - 1) {
             int rc = report(progress, done + share * (double)i / (double)b->n, err);
@@ -254,7 +317,8 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
         size_t degree;
         const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
         if (b->rings.hull[i] || degree < 3 || !inside_now(b, (int32_t)i, ring, degree)) {
-            settled_forget(&b->settled, (int32_t)i);
+            if (b->remember)
+                settled_forget(&b->settled, (int32_t)i);
             continue;
         }
         int rc = visit(b, (int32_t)i, ring, degree, &out->refused);
@@ -263,6 +327,8 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
         if (rc) {
             b->moved[b->nmoved++] = (int32_t)i;
             b->moved_in[i] = b->sweep;
+            if (b->domain->periodic)
+                move_ghosts(b, (int32_t)i);
         }
     }
     out->moves += b->nmoved;
@@ -270,13 +336,15 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
 }
 
 /* Measures F again where it is stale or where the last update changed the ring, then
- * the whole structure into *stats. Reads *cancel (may be NULL) as gp_quality does, every
- * GP_QUALITY_CENTRES_PER_CHECK centres: before the sweeps every centre is measured. Returns
- * 0 or GP_ECANCELED with err. */
+ * the whole structure into *stats (ghosts have no F: their marks are only cleared).
+ * Reads *cancel (may be NULL) as gp_quality does, every GP_QUALITY_CENTRES_PER_CHECK
+ * centres: before the sweeps every centre is measured. Returns 0, LAYER_TOO_THIN (a
+ * periodic cell may miss a neighbour beyond the ghosts) or GP_ECANCELED with err. */
 static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp_cancel_flag *cancel,
                    gp_error *err)
 {
-    for (size_t i = 0; i < b->n; i++) {
+    int incomplete = 0;
+    for (size_t i = 0; i < b->m; i++) {
         if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel))
             return gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
         if (i + AHEAD_CELLS < b->n) {
@@ -287,13 +355,18 @@ static int measure(balancer *b, int histogram, gp_quality_stats *stats, const gp
         }
         if (!b->stale[i] && !b->changed[i])
             continue;
-        if (b->changed[i])
-            settled_forget(&b->settled, (int32_t)i); /* a step reads its ring */
-        size_t degree;
-        const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
-        b->F[i] = quality_of_centre(b->domain, b->disks, (int32_t)i, ring, degree, b->rings.hull[i]);
+        if (i < b->n) {
+            if (b->changed[i] && b->remember)
+                settled_forget(&b->settled, (int32_t)i); /* a step reads its ring */
+            size_t degree;
+            const int32_t *ring = rings_of(&b->rings, (int32_t)i, &degree);
+            b->F[i] = quality_of_centre(&b->frame, b->disks, (int32_t)i, ring, degree, b->rings.hull[i],
+                                        &incomplete);
+        }
         b->stale[i] = b->changed[i] = 0;
     }
+    if (incomplete)
+        return LAYER_TOO_THIN;
     quality_summarise(b->F, b->n, histogram, stats);
     return 0;
 }
@@ -309,7 +382,7 @@ static int rings_failed(int rc, size_t n, gp_error *err)
  * moved, and measures the structure into *stats. F is measured again only where it may
  * have changed: at the centres that moved, at their neighbours (their gaps changed),
  * and at every centre whose ring the update changed. */
-static int follow_moves(balancer *b, gp_rt *rt, gp_rt_update update, gp_rt_update_stats *counts,
+static int follow_moves(balancer *b, gp_rt_update update, gp_rt_update_stats *counts,
                         int histogram, const gp_progress *progress, gp_quality_stats *stats,
                         gp_error *err)
 {
@@ -321,11 +394,11 @@ static int follow_moves(balancer *b, gp_rt *rt, gp_rt_update update, gp_rt_updat
         for (size_t k = 0; k < degree; k++)
             b->stale[ring[k]] = 1;
     }
-    int rc = gp_rt_update_moved(rt, b->disks, b->n, b->moved, b->nmoved, update, counts, progress, err);
+    int rc = gp_rt_update_moved(b->rt, b->disks, b->m, b->moved, b->nmoved, update, counts, progress, err);
     if (rc)
         return rc;
-    if ((rc = rings_refresh(&b->rings, rt, b->changed, cancel)))
-        return rings_failed(rc, b->n, err);
+    if ((rc = rings_refresh(&b->rings, b->rt, b->changed, cancel)))
+        return rings_failed(rc, b->m, err);
     return measure(b, histogram, stats, cancel, err);
 }
 
@@ -381,32 +454,113 @@ static double largest_radius(const gp_disk *disks, size_t n)
     return R_max;
 }
 
-/* Sets up what the sweeps work with and measures F before them into out->before; reads
- * the cancel flag of `progress` (may be NULL) while it walks the rings and measures F. */
-static int start_sweeps(balancer *b, gp_rt *rt, const gp_progress *progress, gp_balance_result *out,
-                        gp_error *err)
+/* (Re)allocates the per-vertex marks for m vertices, cleared; 0 or GP_ENOMEM. */
+static int marks_for(balancer *b, size_t m)
 {
-    int rc = nearby_init(&b->near, b->domain, b->disks, b->n, largest_radius(b->disks, b->n));
+    free(b->changed);
+    free(b->stale);
+    free(b->moved_in);
+    free(b->moved);
+    size_t c = m ? m : 1;
+    b->changed = calloc(c, 1);
+    b->stale = calloc(c, 1);
+    b->moved_in = calloc(c, sizeof *b->moved_in);
+    b->moved = malloc(c * sizeof *b->moved);
+    b->m = m;
+    return b->changed && b->stale && b->moved_in && b->moved ? 0 : GP_ENOMEM;
+}
+
+/* Sets up what the sweeps work with from the triangulation b->rt of b->disks[0..m-1] and
+ * measures F into *stats; reads the cancel flag of `progress` (may be NULL) while it
+ * walks the rings and measures F. Returns as measure does. */
+static int start_sweeps(balancer *b, int histogram, const gp_progress *progress,
+                        gp_quality_stats *stats, gp_error *err)
+{
+    const gp_domain *grid_domain = b->domain->periodic ? &b->grid_domain : b->domain;
+    int rc = nearby_init(&b->near, grid_domain, b->disks, b->m, b->R_max);
     if (rc)
         return gp_error_set(err, rc, NULL, rc == GP_ETOOBIG ? "the bucket grid would be too large"
                                                            : "out of memory for the bucket grid");
-    if ((rc = settled_init(&b->settled, &b->near.grid, b->near.R_max, b->n)))
+    /* walled domains only: on a periodic one the grid is made again with each layer and
+     * a move carries ghosts, which the record's log does not follow */
+    if (b->remember && !b->settled.state &&
+        (rc = settled_init(&b->settled, &b->near.grid, b->near.R_max, b->n)))
         return gp_error_set(err, rc, NULL, "out of memory for the record of %zu centres", b->n);
-    if ((rc = rings_init(&b->rings, rt, b->n, progress)))
-        return rings_failed(rc, b->n, err);
-    gp_rt_mark_changes(rt, b->changed);
-    memset(b->stale, 1, b->n);
-    return measure(b, 1, &out->before, gp_progress_cancel(progress), err);
+    if ((rc = rings_init(&b->rings, b->rt, b->m, progress)))
+        return rings_failed(rc, b->m, err);
+    gp_rt_mark_changes(b->rt, b->changed);
+    memset(b->stale, 1, b->m);
+    return measure(b, histogram, stats, gp_progress_cancel(progress), err);
+}
+
+/* Periodic domains: writes the disks back to the caller's array wrapped into the domain,
+ * makes the ghost layer and its triangulation again from them (b->margin, doubled
+ * while some cell may miss a neighbour), and starts the sweeps on it, F measured into
+ * *stats. Returns 0 or a GP_E code with err. */
+static int new_layer(balancer *b, int histogram, const gp_progress *progress,
+                     gp_quality_stats *stats, gp_error *err)
+{
+    for (;;) {
+        for (size_t i = 0; i < b->n; i++) {
+            b->user[i] = b->disks[i];
+            gp_domain_wrap(b->domain, &b->user[i].x, &b->user[i].y);
+        }
+        periodic_layer_free(&b->layer);
+        nearby_free(&b->near);
+        rings_free(&b->rings);
+        b->disks = b->user;
+        b->rt = NULL;
+        /* the cancel flag only: the job's progress stays in the stage "balance" */
+        gp_progress quiet = {NULL, NULL, gp_progress_cancel(progress)};
+        int rc = periodic_layer_build(&b->layer, b->domain, b->user, b->n, b->margin, &quiet, err);
+        if (rc)
+            return rc;
+        b->disks = b->layer.all;
+        b->rt = b->layer.rt;
+        if (marks_for(b, b->layer.m))
+            return gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", b->n);
+        for (size_t i = 0; i < b->n; i++) {
+            b->anchor[2 * i] = b->disks[i].x;
+            b->anchor[2 * i + 1] = b->disks[i].y;
+        }
+        b->drift = 0.0;
+        b->frame = (quality_frame){b->domain, b->margin, b->R_max};
+        rc = start_sweeps(b, histogram, progress, stats, err);
+        if (rc != LAYER_TOO_THIN)
+            return rc;
+        double last = periodic_last_margin(b->domain);
+        if (b->margin >= last)
+            return periodic_too_small(err);
+        b->margin = 2.0 * b->margin < last ? 2.0 * b->margin : last;
+    }
+}
+
+/* After a sweep: brings the triangulation, the rings and F up to date (follow_moves) or,
+ * on a periodic domain with GP_RT_UPDATE_REBUILD, makes the layer again; a layer that
+ * turns out too thin is made again wider. */
+static int follow(balancer *b, gp_rt_update update, gp_rt_update_stats *counts, int histogram,
+                  const gp_progress *progress, gp_quality_stats *stats, gp_error *err)
+{
+    if (b->domain->periodic && update == GP_RT_UPDATE_REBUILD) {
+        counts->rebuilds++;
+        return new_layer(b, histogram, progress, stats, err);
+    }
+    int rc = follow_moves(b, update, counts, histogram, progress, stats, err);
+    if (rc != LAYER_TOO_THIN)
+        return rc;
+    b->margin *= 2.0;
+    return new_layer(b, histogram, progress, stats, err);
 }
 
 /* Sweeps until one moves nothing, the structure is steady, the best structure has not
  * improved for GP_BALANCE_STALL_SWEEPS sweeps, or the cap (docs/method.md §4.5); then
  * returns to the best structure and measures it into out->after and out->F. */
-static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
-                      const gp_progress *progress, gp_balance_result *out, gp_error *err)
+static int run_sweeps(balancer *b, const gp_balance_params *params, const gp_progress *progress,
+                      gp_balance_result *out, gp_error *err)
 {
     uint32_t cap = params->max_iterations ? params->max_iterations : GP_BALANCE_DEFAULT_MAX_ITERATIONS;
-    int rc = start_sweeps(b, rt, progress, out, err);
+    int rc = b->domain->periodic ? new_layer(b, 1, progress, &out->before, err)
+                                 : start_sweeps(b, 1, progress, &out->before, err);
     if (rc)
         return rc;
     /* `best` is the structure returned; the lowest F_max and the lowest mean seen, even
@@ -422,6 +576,12 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
     out->stop = GP_BALANCE_STOP_CAP;
     for (uint32_t stall = 0; out->sweeps < cap;) {
         double share = 1.0 / cap;
+        if (b->domain->periodic && b->drift > LAYER_DRIFT_SHARE * b->layer.margin) {
+            /* the same structure, wrapped: F as it was, to rounding */
+            out->triangulation.rebuilds++;
+            if ((rc = new_layer(b, 0, progress, &now, err)))
+                return rc;
+        }
         b->sweep = (uint8_t)(out->sweeps + 1);
         if ((rc = sweep(b, progress, share * out->sweeps, share, out, err)))
             return rc;
@@ -430,7 +590,7 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
             out->stop = GP_BALANCE_STOP_CONVERGED;
             break;
         }
-        if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 0, progress, &now, err)) ||
+        if ((rc = follow(b, params->update, &out->triangulation, 0, progress, &now, err)) ||
             (rc = report(progress, share * out->sweeps, err)))
             return rc;
         nearby_sort(&b->near, b->disks);
@@ -460,9 +620,13 @@ static int run_sweeps(balancer *b, gp_rt *rt, const gp_balance_params *params,
         }
     }
     restore_best(b);
-    if ((rc = follow_moves(b, rt, params->update, &out->triangulation, 1, progress, &out->after, err)))
-        return rc;
-    return 0;
+    if (b->domain->periodic) {
+        /* the returned structure measured as gp_quality measures it: wrapped, from a layer
+         * of the first margin */
+        b->margin = periodic_first_margin(b->domain, b->R_max);
+        return new_layer(b, 1, progress, &out->after, err);
+    }
+    return follow_moves(b, params->update, &out->triangulation, 1, progress, &out->after, err);
 }
 
 int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
@@ -475,6 +639,7 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
     b.domain = domain;
     b.disks = disks;
     b.n = n;
+    b.remember = !domain->periodic;
     b.method = params->method;
     b.max_step = params->max_step > 0.0 ? params->max_step : GP_BALANCE_DEFAULT_MAX_STEP;
     out->method = params->method;
@@ -494,22 +659,30 @@ int gp_balance(const gp_domain *domain, gp_disk *disks, size_t n, gp_rt *rt,
         out->after = out->before;
     } else {
         b.F = out->F;
-        b.changed = calloc(m, 1);
-        b.stale = calloc(m, 1);
-        b.moved_in = calloc(m, sizeof *b.moved_in);
-        b.moved = malloc(m * sizeof *b.moved);
+        b.rt = rt;
+        b.R_max = largest_radius(disks, n);
         b.best = malloc(2 * m * sizeof *b.best);
-        if (!b.changed || !b.stale || !b.moved_in || !b.moved || !b.best) {
+        if (domain->periodic) {
+            b.user = disks;
+            b.grid_domain = (gp_domain){domain->width, domain->height, 0};
+            b.margin = periodic_first_margin(domain, b.R_max);
+            b.anchor = malloc(2 * m * sizeof *b.anchor);
+        } else {
+            b.frame = (quality_frame){domain, 0.0, 0.0};
+        }
+        if (!b.best || (domain->periodic && !b.anchor) || (!domain->periodic && marks_for(&b, n))) {
             rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory balancing %zu disks", n);
             goto done;
         }
-        if ((rc = run_sweeps(&b, rt, params, progress, out, err)))
+        if ((rc = run_sweeps(&b, params, progress, out, err)))
             goto done;
     }
     if (progress && progress->report)
         progress->report(progress->ctx, "balance", 1.0);
 done:
-    gp_rt_mark_changes(rt, NULL);
+    if (b.rt && !domain->periodic)
+        gp_rt_mark_changes(b.rt, NULL);
+    periodic_layer_free(&b.layer);
     nearby_free(&b.near);
     settled_free(&b.settled);
     rings_free(&b.rings);
@@ -519,6 +692,7 @@ done:
     free(b.tangent);
     free(b.moved);
     free(b.best);
+    free(b.anchor);
     if (rc)
         gp_balance_result_free(out);
     return rc;

@@ -1,10 +1,11 @@
 /* io_inp.c - the mesh as an Abaqus input file: nodes, elements of the plane stress or
  * plane strain family, an element set per grain and one for the second phase, a node set
- * per domain side. */
+ * per domain side (on a periodic axis, the two sides' sets in matching order). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "grainpack/io_mesh.h"
+#include "writer.h"
 
 /* Abaqus data lines hold at most 16 entries. */
 #define INP_PER_LINE 16
@@ -45,10 +46,38 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The node set of a periodic side, in the order of its pairs (gp_mesh_periodic_pairs:
+ * along the side, corners first and last), so that the k-th node of `left` pairs with the
+ * k-th of `right` (`bottom` with `top`) for *EQUATION; "unsorted" keeps that order. */
+static int periodic_set(gp_out *o, const gp_domain *d, const gp_mesh *m, gp_mesh_side side, int axis)
+{
+    int32_t *pairs;
+    size_t n;
+    int rc = gp_mesh_periodic_pairs(m, d, axis, &pairs, &n);
+    if (rc)
+        return rc;
+    uint64_t *list = malloc((n ? n : 1) * sizeof *list);
+    if (!list) {
+        free(pairs);
+        return GP_ENOMEM;
+    }
+    int high = side == GP_SIDE_RIGHT || side == GP_SIDE_TOP;
+    for (size_t k = 0; k < n; k++)
+        list[k] = (uint64_t)pairs[2 * k + high] + 1;
+    gp_out_puts(o, "*Nset, nset=");
+    gp_out_puts(o, gp_mesh_side_name(side));
+    gp_out_puts(o, ", unsorted\n");
+    ids(o, list, n);
+    free(list);
+    free(pairs);
+    return 0;
+}
+
 int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
-    if (!result->has_mesh)
-        return GP_EINVAL;
+    int checked = gp_mesh_result_check(result, GP_FORMAT_INP, NULL);
+    if (checked)
+        return checked;
     const gp_mesh *m = &result->mesh;
     const gp_mesh_params *p = &spec->mesh;
     uint64_t *list = malloc(((m->order + 1) * m->nbedges + 1) * sizeof *list);
@@ -107,8 +136,13 @@ int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result)
         gp_out_uint(o, last);
         gp_out_puts(o, ", 1\n");
     }
-    int stride = m->order + 1;
-    for (int s = 0; s < GP_SIDE_COUNT; s++) {
+    int stride = m->order + 1, rc = 0;
+    for (int s = 0; s < GP_SIDE_COUNT && rc == 0; s++) {
+        int axis = s == GP_SIDE_LEFT || s == GP_SIDE_RIGHT ? 0 : 1;
+        if (spec->domain.periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)) {
+            rc = periodic_set(o, &spec->domain, m, (gp_mesh_side)s, axis);
+            continue;
+        }
         size_t n = 0;
         for (size_t e = 0; e < m->nbedges; e++)
             if (m->bedge_side[e] == s)
@@ -127,5 +161,6 @@ int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result)
         ids(o, list, w);
     }
     free(list);
-    return gp_out_flush(o);
+    int flushed = gp_out_flush(o);
+    return rc ? rc : flushed;
 }

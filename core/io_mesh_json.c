@@ -17,7 +17,7 @@ json_t *gp_mesh_statistics_json(const gp_spec *spec, const gp_mesh *mesh)
         return NULL;
     const char *second = mesh->kind == GP_MESH_CELLS ? NULL
                          : mesh->kind == GP_MESH_DISKS_IN_MATRIX ? "matrix" : "grain_boundary";
-    return json_pack(
+    json_t *stats = json_pack(
         "{s:s, s:{s:f, s:f, s:i, s:i, s:f, s:b}, s:I, s:{s:I, s:I, s:I}, s:I, s:{s:f, s:f, s:I, s:f},"
         " s:{s:f, s:f, s:o, s:s}, s:{s:f, s:f, s:f, s:f, s:f, s:s?, s:f, s:f}, s:I,"
         " s:{s:I, s:f, s:f}}",
@@ -41,4 +41,23 @@ json_t *gp_mesh_statistics_json(const gp_spec *spec, const gp_mesh *mesh)
         "refused_refinements", (json_int_t)s->refused_refinements,
         "band_strips", "count", (json_int_t)s->band_strips, "thickness_min", s->band_thickness_min,
         "thickness_mean", s->band_thickness_mean);
+    unsigned per = spec->domain.periodic;
+    json_t *axes = json_array();
+    if (axes && (per & GP_PERIODIC_X))
+        json_array_append_new(axes, json_string("x"));
+    if (axes && (per & GP_PERIODIC_Y))
+        json_array_append_new(axes, json_string("y"));
+    if (!stats) {
+        json_decref(axes);
+        return NULL;
+    }
+    if (!axes ||
+        json_object_set_new(stats, "periodic",
+                            json_pack("{s:o, s:{s:I, s:I}, s:i}", "axes", axes, "node_pairs", "x",
+                                      (json_int_t)s->periodic_pairs[0], "y",
+                                      (json_int_t)s->periodic_pairs[1], "rounds", s->rounds))) {
+        json_decref(stats);
+        return NULL;
+    }
+    return stats;
 }

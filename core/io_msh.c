@@ -1,8 +1,10 @@
 /* io_msh.c - the mesh as Gmsh MSH 4.1 ASCII: entities (a surface per region, a curve per
- * domain side) with their physical groups, nodes, elements. */
+ * domain side) with their physical groups, nodes, elements, and on a periodic domain the
+ * periodic curves with their node pairs. */
 #include <stdlib.h>
 
 #include "grainpack/io_mesh.h"
+#include "writer.h"
 
 /* Gmsh element types (MSH format reference, "elm-type"). */
 #define MSH_LINE2 1
@@ -81,10 +83,65 @@ static void element(gp_out *o, uint64_t *tag, const int32_t *nodes, int n)
     gp_out_char(o, '\n');
 }
 
+/* The $Periodic section (MSH 4.1) of a periodic domain: curve `right` is the periodic
+ * copy of curve `left`, `top` of `bottom`, by the translation of one period (the 4 x 4
+ * affine matrix, by rows, maps the master's points to the copy's), with every node pair,
+ * corners included (gp_mesh_periodic_pairs). Nothing on a walled domain. */
+static int periodic_section(gp_out *o, const gp_domain *d, const gp_mesh *m)
+{
+    int32_t *pairs[2] = {NULL, NULL};
+    size_t n[2] = {0, 0}, links = 0;
+    int rc = 0;
+    for (int axis = 0; axis < 2 && rc == 0; axis++) {
+        rc = gp_mesh_periodic_pairs(m, d, axis, &pairs[axis], &n[axis]);
+        links += n[axis] > 0;
+    }
+    if (rc == 0 && links) {
+        gp_out_puts(o, "$Periodic\n");
+        gp_out_uint(o, links);
+        gp_out_char(o, '\n');
+        for (int axis = 0; axis < 2; axis++) {
+            if (!n[axis])
+                continue;
+            /* the copy (right, top) and its master (left, bottom), as curve tags */
+            int copy = (axis == 0 ? GP_SIDE_RIGHT : GP_SIDE_TOP) + 1;
+            int master = (axis == 0 ? GP_SIDE_LEFT : GP_SIDE_BOTTOM) + 1;
+            double shift[2] = {axis == 0 ? d->width : 0.0, axis == 1 ? d->height : 0.0};
+            gp_out_puts(o, "1 ");
+            gp_out_int(o, copy);
+            gp_out_char(o, ' ');
+            gp_out_int(o, master);
+            gp_out_puts(o, "\n16");
+            for (int r = 0; r < 4; r++)
+                for (int c = 0; c < 4; c++) {
+                    gp_out_char(o, ' ');
+                    if (c == 3 && r < 2)
+                        gp_out_double(o, shift[r]);
+                    else
+                        gp_out_int(o, r == c);
+                }
+            gp_out_char(o, '\n');
+            gp_out_uint(o, n[axis]);
+            gp_out_char(o, '\n');
+            for (size_t k = 0; k < n[axis]; k++) {
+                gp_out_int(o, (int64_t)pairs[axis][2 * k + 1] + 1);
+                gp_out_char(o, ' ');
+                gp_out_int(o, (int64_t)pairs[axis][2 * k] + 1);
+                gp_out_char(o, '\n');
+            }
+        }
+        gp_out_puts(o, "$EndPeriodic\n");
+    }
+    free(pairs[0]);
+    free(pairs[1]);
+    return rc;
+}
+
 int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
-    if (!result->has_mesh)
-        return GP_EINVAL;
+    int checked = gp_mesh_result_check(result, GP_FORMAT_MSH, NULL);
+    if (checked)
+        return checked;
     const gp_mesh *m = &result->mesh;
     size_t nregions = m->ngrains + 1;
     size_t *tri_start = malloc((nregions + 1) * sizeof *tri_start);
@@ -209,5 +266,7 @@ int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
     }
     gp_out_puts(o, "$EndElements\n");
     free(tri_start);
-    return gp_out_flush(o);
+    int rc = periodic_section(o, &spec->domain, m);
+    int flushed = gp_out_flush(o);
+    return rc ? rc : flushed;
 }

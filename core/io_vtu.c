@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "grainpack/io_mesh.h"
+#include "writer.h"
 
 /* VTK cell types (vtkCellType.h). */
 #define VTK_VERTEX 1
@@ -220,5 +221,8 @@ static int write_grains(gp_out *o, const gp_result *result)
 int gp_write_vtu(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
     (void)spec;
+    int checked = gp_mesh_result_check(result, GP_FORMAT_VTU, NULL);
+    if (checked)
+        return checked;
     return result->has_mesh ? write_mesh(o, result) : write_grains(o, result);
 }

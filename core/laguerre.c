@@ -13,11 +13,6 @@
 
 /* Cells between two progress reports and cancel checks: a few milliseconds of work. */
 #define CELLS_PER_REPORT 16384
-/* The first ghost margin on a periodic domain, in largest packing radii: a cell of a
- * dense packing reaches about one radius past its disk, so its vertices' power circles
- * stay within a few radii; a margin too small is found out cell by cell (cell_complete)
- * and doubled, up to a period. */
-#define GHOST_MARGIN_RADII 6.0
 /* build_cell's answer when a periodic cell may miss a neighbour beyond the ghosts. */
 #define CELL_INCOMPLETE 1
 
@@ -466,11 +461,11 @@ static int periodic_cells(const gp_domain *domain, const gp_disk *disks, size_t 
     double R_max = 0.0;
     for (size_t i = 0; i < n; i++)
         R_max = disks[i].R > R_max ? disks[i].R : R_max;
-    double period = (domain->periodic & GP_PERIODIC_X) ? domain->width : domain->height;
-    if ((domain->periodic & GP_PERIODIC_Y) && domain->height < period)
-        period = domain->height;
+    /* the first margin (periodic.h) is found too small cell by cell (cell_complete) and
+     * doubled, up to a period */
+    double period = periodic_last_margin(domain);
     memset(out, 0, sizeof *out);
-    for (double margin = GHOST_MARGIN_RADII * R_max;; margin *= 2.0) {
+    for (double margin = PERIODIC_MARGIN_RADII * R_max;; margin *= 2.0) {
         if (margin > period)
             margin = period;
         gp_disk *all;
@@ -489,9 +484,7 @@ static int periodic_cells(const gp_domain *domain, const gp_disk *disks, size_t 
         if (rc != CELL_INCOMPLETE)
             return rc;
         if (margin >= period)
-            return gp_error_set(err, GP_EGEOM, NULL,
-                                "a periodic cell reaches beyond a whole period of images: the "
-                                "domain is too small for its largest void");
+            return periodic_too_small(err);
     }
 }
 

@@ -262,6 +262,25 @@ static int boundary_edges(gp_mesh *mesh, const gp_domain *d, const gp_pair_map *
     return 0;
 }
 
+/* The node pairs across each periodic side, counted into the statistics: the refinement
+ * made the sides' nodes translates of each other, checked here once more on the mesh as
+ * written (second-order nodes included). */
+static int count_pairs(gp_mesh *mesh, const gp_domain *d, gp_error *err)
+{
+    for (int axis = 0; axis < 2; axis++) {
+        int32_t *pairs;
+        int rc = gp_mesh_periodic_pairs(mesh, d, axis, &pairs, &mesh->stats.periodic_pairs[axis]);
+        free(pairs);
+        if (rc == GP_ENOMEM)
+            return oom(err);
+        if (rc)
+            return gp_error_set(err, GP_EINTERNAL, NULL,
+                                "mesh: the nodes of the periodic sides along %c do not pair up",
+                                axis == 0 ? 'x' : 'y');
+    }
+    return 0;
+}
+
 /* The triangles the refinement should end with, for its progress: the area over the
  * typical triangle of the size bound, at least a few per input point. */
 static double expected_triangles(const gp_mesh_geometry *geo, const gp_domain *d, double h)
@@ -333,6 +352,9 @@ int gp_mesh_build(const gp_mesh_input *in, const gp_mesh_params *params,
         out->stats.band_thickness_mean += w / (double)geo.nstrips;
     }
     out->stats.refused_refinements = cdt.dropped;
+    out->stats.rounds = cdt.rounds;
+    if ((rc = count_pairs(out, in->domain, err)))
+        goto done;
     report(progress, 1.0);
 done:
     gp_cdt_mesh_free(&cdt);

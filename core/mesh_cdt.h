@@ -35,6 +35,12 @@ typedef struct gp_pslg {
     int32_t default_region;  /* the region of what no seed reaches; -1: there must be none */
     size_t nstrips;
     int32_t *strip_corners;  /* a0, a1, b0, b1 of each strip */
+    size_t npairs;           /* periodic sides: side a (a0 to a1) and side b (b0 to b1), a
+                                translate of a; the refinement splits them like any side,
+                                then puts on each the translates of the other's nodes
+                                (bit for bit: the sides are axis-parallel, so a translate
+                                keeps the coordinate along the side and sets the other) */
+    int32_t pair_corners[2 * 4]; /* a0, a1, b0, b1 of each pair (at most one per axis) */
     size_t xy_cap, seg_cap, protected_cap, seed_xy_cap, seed_region_cap, strip_cap; /* allocated */
 } gp_pslg;
 
@@ -47,6 +53,10 @@ int gp_pslg_seed(gp_pslg *g, double x, double y, int32_t region);
 /* Appends a strip (its sides and ends must be segments too); returns 0 or GP_ENOMEM. */
 int gp_pslg_strip(gp_pslg *g, int32_t a0, int32_t a1, int32_t b0, int32_t b1);
 void gp_pslg_free(gp_pslg *g);
+
+/* The graded region's local size is the band's thickness times this: elements about as
+ * long as the band is thick (issue 11), one row of triangles across a strip. */
+#define GP_CDT_GRADED_SIZE_PER_THICKNESS 1.5
 
 typedef struct gp_cdt_params {
     double size_bound;        /* the longest edge allowed (0: none) */
@@ -74,7 +84,8 @@ typedef struct gp_cdt_mesh {
                              protected segment */
     size_t *strip_start;  /* nstrips + 1 offsets into strip_sides */
     int32_t *strip_sides; /* strip k: the nodes of side a (a0 .. a1), then as many of side b */
-    int rounds;           /* refinements run until every strip's sides matched */
+    int rounds;           /* refinements run until every strip's and periodic pair's sides
+                             matched */
 } gp_cdt_mesh;
 
 /* Inserts the points and segments of `g` in a CGAL constrained Delaunay triangulation,
@@ -82,8 +93,9 @@ typedef struct gp_cdt_mesh {
  * circumcentre) until no triangle has an edge over size_bound (over its own bound in
  * the graded region) or an angle under the shape bound, except where that would split a
  * protected segment, mirrors the splits of
- * strip sides onto the facing sides and refines again until they match (the last round
- * protects the sides), then labels the triangles by region. Returns 0 and fills `out` (free with gp_cdt_mesh_free), or
+ * strip sides onto the facing sides (and of periodic sides onto their translates) and
+ * refines again until they match (the last round protects the sides), then labels the
+ * triangles by region. Returns 0 and fills `out` (free with gp_cdt_mesh_free), or
  * GP_ENOMEM, GP_ECANCELED, GP_ETOOBIG, GP_EGEOM (a seed's region leaks into another's, or
  * triangles no seed reaches with default_region -1) or GP_EINTERNAL (CGAL threw); err
  * says what and `out` is zeroed. */

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "mesh_internal.h"
+#include "periodic.h"
 
 /* Points closer than this times the mean packing radius are one point. Why this value:
  * cells are computed per grain, so a vertex shared by three cells comes out three times
@@ -33,6 +34,11 @@
  * corners and short edges, where the junction's triangles must be small. */
 #define STRIP_PULLBACK 0.75
 
+/* Periodic domains without cells: the disks' images are made this many largest packing
+ * radii beyond the periodic sides, so that a disk's contacts across a side are with
+ * images in its own triangulation (a touching disk's centre is within 2 R_max). */
+#define CONTACT_GHOST_RADII 2.5
+
 /* A point added to an outline edge (a strip's node): polygon, edge, position along it. */
 typedef struct edge_point {
     int32_t poly, edge;
@@ -47,11 +53,17 @@ typedef struct builder {
     gp_pslg *g;
     gp_error *err;
     double W, H, tol;
-    /* the outlines before welding: polygon p has raw vertices pstart[p] .. pstart[p+1]-1 */
+    unsigned periodic;       /* the domain's periodic axes */
+    const gp_disk *disks;    /* the disks (and, periodic without cells, their images) */
+    const gp_rt *rt;         /* their triangulation (disks without cells) */
+    size_t nrt;              /* the disks in it */
+    /* the outlines before welding: polygon p has raw vertices pstart[p] .. pstart[p+1]-1
+       and is (a piece of) grain region[p] */
     size_t npoly;
     size_t *pstart;
+    int32_t *region;
     double *raw;
-    size_t nraw, raw_cap, pstart_cap;
+    size_t nraw, raw_cap, pstart_cap, region_cap;
     /* after welding: the point of each raw vertex, and each polygon's ring without repeats */
     int32_t *ring;
     size_t *rstart;
@@ -75,13 +87,16 @@ static int raw_vertex(builder *b, double x, double y)
     return 0;
 }
 
-/* Closes polygon number b->npoly (its vertices are the raw ones added since the last). */
-static int close_polygon(builder *b)
+/* Closes polygon number b->npoly (its vertices are the raw ones added since the last),
+ * an outline of grain `grain`. */
+static int close_polygon(builder *b, size_t grain)
 {
-    if (gp_mesh_reserve((void **)&b->pstart, &b->pstart_cap, b->npoly + 2, sizeof *b->pstart))
+    if (gp_mesh_reserve((void **)&b->pstart, &b->pstart_cap, b->npoly + 2, sizeof *b->pstart) ||
+        gp_mesh_reserve((void **)&b->region, &b->region_cap, b->npoly + 1, sizeof *b->region))
         return oom(b);
     if (b->npoly == 0)
         b->pstart[0] = 0;
+    b->region[b->npoly] = (int32_t)grain;
     b->pstart[++b->npoly] = b->nraw;
     return 0;
 }
@@ -95,7 +110,7 @@ static int collect_cells(builder *b)
         for (size_t k = c->start[i]; k < c->start[i + 1]; k++)
             if (raw_vertex(b, c->xy[2 * k], c->xy[2 * k + 1]))
                 return GP_ENOMEM;
-        if (close_polygon(b))
+        if (close_polygon(b, i))
             return GP_ENOMEM;
     }
     return 0;
@@ -105,6 +120,7 @@ static int collect_cells(builder *b)
 
 typedef struct contact {
     double angle, x, y, min_step; /* min_step: of the outline edges on either side */
+    int crossing;                 /* a crossing of a periodic side's line (side_crossings) */
 } contact;
 
 static int by_angle(const void *a, const void *b)
@@ -151,30 +167,92 @@ static int add_contact(contact **list, size_t *n, size_t *cap, double angle, dou
         return GP_ENOMEM;
     if (angle < 0.0)
         angle += 2.0 * M_PI;
-    (*list)[(*n)++] = (contact){angle, x, y, min_step};
+    (*list)[(*n)++] = (contact){angle, x, y, min_step, 0};
     return 0;
 }
 
-/* The contacts of disk i with the walls. */
+/* Drops the crossings of a side's line that lie closer to a contact (around the circle)
+ * than the contact's minimum step: the outline's edge from the contact then spans its
+ * wedge angle and is cut by the line where it crosses it (a crossing point kept there
+ * would make the two touching outlines' edges a cusp of matrix as thin as their gap). */
+static void drop_crowded_crossings(contact *list, size_t *n)
+{
+    size_t w = 0;
+    for (size_t k = 0; k < *n; k++) {
+        int keep = 1;
+        for (size_t c = 0; c < *n && keep && list[k].crossing; c++) {
+            if (list[c].crossing)
+                continue;
+            double gap = fabs(list[k].angle - list[c].angle);
+            keep = fmin(gap, 2.0 * M_PI - gap) >= list[c].min_step;
+        }
+        if (keep)
+            list[w++] = list[k];
+    }
+    *n = w;
+}
+
+/* The contacts of disk i with the walls (the sides along walled axes). */
 static int wall_contacts(builder *b, const gp_disk *d, double wall_step, contact **list,
                          size_t *n, size_t *cap)
 {
     double gap = CONTACT_RTOL * 2.0 * d->r;
-    int rc = 0;
-    if (d->x - d->r <= gap)
+    int rc = 0, wx = !(b->periodic & GP_PERIODIC_X), wy = !(b->periodic & GP_PERIODIC_Y);
+    if (wx && d->x - d->r <= gap)
         rc |= add_contact(list, n, cap, M_PI, 0.0, d->y, wall_step);
-    if (b->W - d->x - d->r <= gap)
+    if (wx && b->W - d->x - d->r <= gap)
         rc |= add_contact(list, n, cap, 0.0, b->W, d->y, wall_step);
-    if (d->y - d->r <= gap)
+    if (wy && d->y - d->r <= gap)
         rc |= add_contact(list, n, cap, -0.5 * M_PI, d->x, 0.0, wall_step);
-    if (b->H - d->y - d->r <= gap)
+    if (wy && b->H - d->y - d->r <= gap)
         rc |= add_contact(list, n, cap, 0.5 * M_PI, d->x, b->H, wall_step);
+    return rc;
+}
+
+/* The points where disk d's outline meets the periodic sides' lines (x = 0 and W along
+ * x, y = 0 and H along y; the disk is unwrapped, so it may cross either): where the circle
+ * crosses a line, its two crossing points, so that its pieces on either side start on the
+ * line at a vertex of the outline and not with a chord nearly along it (a sliver of grain
+ * or of matrix as thin as the chord's distance to the line, which the refinement could
+ * only fill with a cascade of tiny elements); where the circle passes within `near` of a
+ * line (crossing it or not), one point on the line, as where a disk touches a wall. */
+static int side_crossings(builder *b, const gp_disk *d, double near, double step, contact **list,
+                          size_t *n, size_t *cap)
+{
+    int rc = 0;
+    for (int axis = 0; axis < 2; axis++) {
+        if (!(b->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)))
+            continue;
+        double c0 = axis == 0 ? d->x : d->y, c1 = axis == 0 ? d->y : d->x;
+        double lines[2] = {0.0, axis == 0 ? b->W : b->H};
+        for (int k = 0; k < 2; k++) {
+            double off = lines[k] - c0, dist = fabs(off);
+            double toward = axis == 0 ? (off > 0.0 ? 0.0 : M_PI) : (off > 0.0 ? 0.5 * M_PI : -0.5 * M_PI);
+            if (fabs(dist - d->r) <= near) {
+                double p[2];
+                p[axis] = lines[k];
+                p[1 - axis] = c1;
+                rc |= add_contact(list, n, cap, toward, p[0], p[1], 2.0 * step);
+            } else if (dist < d->r) {
+                double half = acos(dist / d->r), chord = sqrt(d->r * d->r - dist * dist);
+                for (int sgn = -1; sgn <= 1; sgn += 2) {
+                    /* the angle and the point: toward the line, turned by +-half */
+                    double a = toward + sgn * half, p[2];
+                    p[axis] = lines[k];
+                    p[1 - axis] = c1 + (axis == 0 ? 1.0 : -1.0) * sgn * (off > 0.0 ? 1.0 : -1.0) * chord;
+                    rc |= add_contact(list, n, cap, a, p[0], p[1], step);
+                    if (rc == 0)
+                        (*list)[*n - 1].crossing = 1;
+                }
+            }
+        }
+    }
     return rc;
 }
 
 static int collect_disks(builder *b, const gp_progress *progress)
 {
-    const gp_disk *disks = b->in->disks;
+    const gp_disk *disks = b->disks;
     size_t n = b->in->ndisks;
     double theta = b->params->min_angle * M_PI / 180.0 * CONTACT_WEDGE_MARGIN;
     double step = 2.0 * acos(1.0 - b->params->disk_tolerance);
@@ -192,8 +270,8 @@ static int collect_disks(builder *b, const gp_progress *progress)
         nlist = 0;
         int hull;
         size_t degree = 0;
-        if (n > 1) {
-            while ((degree = gp_rt_ring(b->in->rt, (int32_t)i, ring, ring_cap, &hull)) > ring_cap) {
+        if (b->nrt > 1) {
+            while ((degree = gp_rt_ring(b->rt, (int32_t)i, ring, ring_cap, &hull)) > ring_cap) {
                 if (gp_mesh_reserve((void **)&ring, &ring_cap, degree, sizeof *ring)) {
                     rc = oom(b);
                     break;
@@ -214,9 +292,12 @@ static int collect_disks(builder *b, const gp_progress *progress)
                              lo->y + uy * reach, theta);
         }
         if (rc == 0)
-            rc = wall_contacts(b, d, 2.0 * theta, &list, &nlist, &list_cap) ? oom(b) : 0;
+            rc = wall_contacts(b, d, 2.0 * theta, &list, &nlist, &list_cap) ||
+                         side_crossings(b, d, b->params->disk_tolerance * d->r, theta, &list, &nlist, &list_cap)
+                     ? oom(b) : 0;
         if (rc)
             break;
+        drop_crowded_crossings(list, &nlist);
         if (nlist == 0) {
             int m = (int)ceil(2.0 * M_PI / step - 1e-9);
             m = m < 3 ? 3 : m;
@@ -235,10 +316,117 @@ static int collect_disks(builder *b, const gp_progress *progress)
             }
         }
         if (rc == 0)
-            rc = close_polygon(b);
+            rc = close_polygon(b, i);
     }
     free(list);
     free(ring);
+    return rc;
+}
+
+/* The disks' outlines on a periodic domain: their contacts across the periodic sides are
+ * with images, found in a triangulation of the disks and their images (the one given is
+ * of the disks alone). */
+static int collect_periodic_disks(builder *b, const gp_progress *progress)
+{
+    const gp_mesh_input *in = b->in;
+    gp_disk *images = NULL;
+    int32_t *origin = NULL;
+    gp_rt *own_rt = NULL;
+    double R_max = 0.0;
+    for (size_t i = 0; i < in->ndisks; i++)
+        R_max = fmax(R_max, in->disks[i].R);
+    int rc = 0;
+    if (periodic_images(in->domain, in->disks, in->ndisks, CONTACT_GHOST_RADII * R_max, &images,
+                        &origin, &b->nrt))
+        rc = oom(b);
+    else if (b->nrt > 1)
+        rc = gp_rt_build(images, b->nrt, progress, &own_rt, b->err);
+    b->disks = images;
+    b->rt = own_rt;
+    if (rc == 0)
+        rc = collect_disks(b, progress);
+    b->disks = in->disks;
+    b->rt = NULL;
+    gp_rt_free(own_rt);
+    free(images);
+    free(origin);
+    return rc;
+}
+
+/* ---- periodic domains: the outlines cut into pieces ---- */
+
+/* Puts the outline vertices within GP_MESH_SIDE_SNAP_RTOL mean radii of a periodic side's
+ * line on it (docs/method.md §7.2). */
+static void snap_to_sides(builder *b)
+{
+    double R_sum = 0.0;
+    for (size_t i = 0; i < b->in->ndisks; i++)
+        R_sum += b->in->disks[i].R;
+    double eps = GP_MESH_SIDE_SNAP_RTOL * (b->in->ndisks ? R_sum / (double)b->in->ndisks : 0.0);
+    for (int axis = 0; axis < 2; axis++) {
+        if (!(b->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)))
+            continue;
+        double period = axis == 0 ? b->W : b->H;
+        for (size_t k = 0; k < b->nraw; k++) {
+            double *c = &b->raw[2 * k + axis];
+            if (fabs(*c) <= eps)
+                *c = 0.0;
+            else if (fabs(*c - period) <= eps)
+                *c = period;
+        }
+    }
+}
+
+/* Each outline (unwrapped: it may cross the periodic sides) replaced by its pieces in
+ * the domain: the parts of the outline inside the domain's translates by a period along
+ * the periodic axes, each clipped in unwrapped coordinates (so that the two sides of a
+ * line see the same crossing points) and moved back by its translation. A part thinner
+ * than the weld tolerance is left out: its points would weld onto the side. */
+static int cut_pieces(builder *b)
+{
+    snap_to_sides(b);
+    size_t npoly = b->npoly, most = 0;
+    size_t *pstart = b->pstart;
+    int32_t *region = b->region;
+    double *raw = b->raw;
+    for (size_t p = 0; p < npoly; p++)
+        most = pstart[p + 1] - pstart[p] > most ? pstart[p + 1] - pstart[p] : most;
+    double *piece = malloc(2 * (most + 4) * sizeof *piece), *work = malloc(2 * (most + 4) * sizeof *work);
+    b->npoly = b->nraw = b->pstart_cap = b->region_cap = b->raw_cap = 0;
+    b->pstart = NULL;
+    b->region = NULL;
+    b->raw = NULL;
+    int rc = piece && work ? 0 : oom(b);
+    int kx = (b->periodic & GP_PERIODIC_X) != 0, ky = (b->periodic & GP_PERIODIC_Y) != 0;
+    for (size_t p = 0; p < npoly && rc == 0; p++) {
+        const double *xy = raw + 2 * pstart[p];
+        size_t n = pstart[p + 1] - pstart[p];
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        for (size_t k = 0; k < n; k++)
+            for (int a = 0; a < 2; a++) {
+                lo[a] = fmin(lo[a], xy[2 * k + a]);
+                hi[a] = fmax(hi[a], xy[2 * k + a]);
+            }
+        for (int sx = -kx; sx <= kx && rc == 0; sx++)
+            for (int sy = -ky; sy <= ky && rc == 0; sy++) {
+                double box[4] = {sx * b->W, (sx + 1) * b->W, sy * b->H, (sy + 1) * b->H};
+                if (fmin(hi[0], box[1]) - fmax(lo[0], box[0]) <= b->tol ||
+                    fmin(hi[1], box[3]) - fmax(lo[1], box[2]) <= b->tol)
+                    continue;
+                size_t m = gp_mesh_clip_box(xy, n, box, piece, work);
+                for (size_t k = 0; k < m && rc == 0; k++)
+                    rc = raw_vertex(b, piece[2 * k] - box[0], piece[2 * k + 1] - box[2]);
+                if (rc == 0 && m >= 3)
+                    rc = close_polygon(b, (size_t)region[p]);
+                else if (rc == 0)
+                    b->nraw -= m;
+            }
+    }
+    free(piece);
+    free(work);
+    free(pstart);
+    free(region);
+    free(raw);
     return rc;
 }
 
@@ -622,7 +810,8 @@ static int by_along(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The domain's sides, counter-clockwise, through every point lying on them. */
+/* The domain's sides, counter-clockwise, through every point lying on them; the periodic
+ * ones paired. */
 static int wall_segments(builder *b)
 {
     int32_t corner[4];
@@ -636,6 +825,15 @@ static int wall_segments(builder *b)
         if (corner[c] < 0 && (corner[c] = gp_pslg_point(b->g, cx[c], cy[c])) < 0)
             return oom(b);
     }
+    /* the periodic pairs, each side run towards rising coordinates: left and right,
+       bottom and top */
+    static const int pair_corners[2][4] = {{0, 3, 1, 2}, {0, 1, 3, 2}};
+    for (int axis = 0; axis < 2; axis++)
+        if (b->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)) {
+            for (int k = 0; k < 4; k++)
+                b->g->pair_corners[4 * b->g->npairs + k] = corner[pair_corners[axis][k]];
+            b->g->npairs++;
+        }
     wall_point *list = malloc((b->g->npoints + 2) * sizeof *list);
     if (!list)
         return oom(b);
@@ -657,6 +855,23 @@ static int wall_segments(builder *b)
     }
     free(list);
     return rc;
+}
+
+/* The seed of polygon p's region: its disk's centre on a walled domain (the centre is in
+ * its outline); on a periodic one, where a piece may not hold the centre, the mean of the
+ * piece's corners (inside: a piece is convex, being a convex outline cut by a box). */
+static int seed(builder *b, size_t p)
+{
+    double x = b->in->disks[b->region[p]].x, y = b->in->disks[b->region[p]].y;
+    if (b->periodic) {
+        size_t begin = b->rstart[p], n = b->rstart[p + 1] - begin;
+        x = y = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            x += b->g->xy[2 * b->ring[begin + k]] / (double)n;
+            y += b->g->xy[2 * b->ring[begin + k] + 1] / (double)n;
+        }
+    }
+    return gp_pslg_seed(b->g, x, y, b->region[p]) ? oom(b) : 0;
 }
 
 /* The smallest angle between two segments at a point, over every point. */
@@ -717,6 +932,7 @@ int gp_mesh_geometry_build(const gp_mesh_input *in, const gp_mesh_params *params
     b.err = err;
     b.W = in->domain->width;
     b.H = in->domain->height;
+    b.periodic = in->domain->periodic;
     double R_sum = 0.0;
     for (size_t i = 0; i < in->ndisks; i++)
         R_sum += in->disks[i].R;
@@ -733,7 +949,20 @@ int gp_mesh_geometry_build(const gp_mesh_input *in, const gp_mesh_params *params
                           "edges are parallel)");
         goto done;
     }
-    if ((rc = in->cells ? collect_cells(&b) : collect_disks(&b, progress)))
+    if (b.periodic && params->band_layers > 0) {
+        rc = gp_error_set(err, GP_EINVAL, NULL,
+                          "band_layers is not available on a periodic domain (the strips would "
+                          "be cut by the periodic sides)");
+        goto done;
+    }
+    b.disks = in->disks;
+    b.rt = in->rt;
+    b.nrt = in->ndisks;
+    if (in->cells)
+        rc = collect_cells(&b);
+    else
+        rc = b.periodic ? collect_periodic_disks(&b, progress) : collect_disks(&b, progress);
+    if (rc || (b.periodic && (rc = cut_pieces(&b))))
         goto done;
     snap_to_walls(&b);
     if (gp_pair_map_init(&b.segments, b.nraw)) {
@@ -742,28 +971,36 @@ int gp_mesh_geometry_build(const gp_mesh_input *in, const gp_mesh_params *params
     }
     if ((rc = weld(&b)) || (rc = clean_rings(&b)))
         goto done;
+    if (b.periodic && gp_mesh_match_sides(b.g, b.periodic, b.W, b.H, b.tol)) {
+        rc = oom(&b);
+        goto done;
+    }
     out->region_area = calloc(out->ngrains + 1, sizeof *out->region_area);
     if (!out->region_area) {
         rc = oom(&b);
         goto done;
     }
     double grains = 0.0;
-    for (size_t p = 0; p < b.npoly; p++)
-        grains += out->region_area[p] = ring_area(&b, p);
+    for (size_t p = 0; p < b.npoly; p++) {
+        double a = ring_area(&b, p);
+        out->region_area[b.region[p]] += a;
+        grains += a;
+    }
     out->region_area[out->ngrains] = out->kind == GP_MESH_CELLS ? 0.0 : b.W * b.H - grains;
     if (params->band_layers > 0 && (rc = build_strips(&b)))
         goto done;
     if ((rc = outline_segments(&b)) || (rc = wall_segments(&b)))
         goto done;
-    for (size_t p = 0; p < b.npoly; p++)
-        if (b.rstart[p + 1] > b.rstart[p] && gp_pslg_seed(b.g, in->disks[p].x, in->disks[p].y, (int32_t)p)) {
-            rc = oom(&b);
-            goto done;
-        }
+    for (size_t p = 0; p < b.npoly && rc == 0; p++)
+        if (b.rstart[p + 1] > b.rstart[p])
+            rc = seed(&b, p);
+    if (rc)
+        goto done;
     b.g->default_region = out->kind == GP_MESH_CELLS ? -1 : (int32_t)out->ngrains;
     rc = input_angles(&b);
 done:
     free(b.pstart);
+    free(b.region);
     free(b.raw);
     free(b.ring);
     free(b.rstart);

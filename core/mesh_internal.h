@@ -60,6 +60,19 @@ int gp_mesh_geometry_build(const gp_mesh_input *input, const gp_mesh_params *par
 
 void gp_mesh_geometry_free(gp_mesh_geometry *g);
 
+/* The part of polygon xy[0 .. 2n-1] inside box = {x0, x1, y0, y1} (Sutherland-Hodgman),
+ * written to `out`; `out` and `work` have room for n + 4 vertices. A crossing of a box
+ * line is computed from the edge's endpoint of lower coordinate: the same edge clipped
+ * by the boxes on either side of a line gives the same point, bit for bit. Returns the
+ * vertices of the part (0: none). */
+size_t gp_mesh_clip_box(const double *xy, size_t n, const double box[4], double *out, double *work);
+
+/* Periodic domains: makes the points of `g` on opposite periodic sides (x = 0 and W
+ * along x, y = 0 and H along y) translates of each other, bit for bit: points within
+ * tol along the side become one coordinate, a point without a partner gets one. Returns
+ * 0 or GP_ENOMEM. */
+int gp_mesh_match_sides(gp_pslg *g, unsigned periodic, double W, double H, double tol);
+
 /* Fills mesh->stats from the elements (angles, quality, areas) against the bound
  * `min_angle` (degrees) and the geometry's polygon areas. */
 void gp_mesh_compute_stats(gp_mesh *mesh, double min_angle, const gp_domain *domain,

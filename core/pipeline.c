@@ -46,12 +46,12 @@ static int mesh(const gp_spec *spec, gp_result *result, const gp_rt *rt,
     return rc;
 }
 
-/* Whether a stage needs the regular triangulation of the disks: the cells of a periodic
- * domain build their own, with the ghost layer (docs/method.md §5.1). */
+/* Whether a stage needs the regular triangulation of the disks: balancing and the cells
+ * of a periodic domain build their own, with the ghost layer (docs/method.md §4.7, §5.1). */
 static int needs_rt(const gp_spec *spec)
 {
-    return spec->balance_enabled || spec->mesh_enabled ||
-           (spec->laguerre_enabled && !spec->domain.periodic);
+    return spec->mesh_enabled ||
+           (!spec->domain.periodic && (spec->balance_enabled || spec->laguerre_enabled));
 }
 
 int gp_pipeline_run(const gp_spec *spec, size_t max_disks, const gp_progress *progress,

@@ -7,17 +7,31 @@
 #include <string.h>
 
 #include "grow.h"
+#include "periodic.h"
+
+/* Whether the power vertex o (relative to p: u) keeps along the axis of length L the
+ * rule of quality_cell_inside: 1, 0 or QUALITY_INCOMPLETE. */
+static int axis_inside(int periodic, double o, double L, double box, double reach)
+{
+    if (!periodic)
+        return o >= 0.0 && o <= L;
+    return o - reach > -box && o + reach < L + box ? 1 : QUALITY_INCOMPLETE;
+}
 
 /* Whether the power cell of p, whose ring is closed (p not on the hull), lies in the
  * domain: every power vertex (the weighted circumcentre of a triangle around p) inside.
  * Near a wall the regular triangulation has long thin triangles across the empty space
  * beyond the wall, whose power vertices lie outside the domain; a centre with such a
  * triangle has neighbours only through the outside, not through the free space around
- * it, and F would measure that instead. */
-int quality_cell_inside(const gp_domain *domain, const gp_disk *disks, int32_t i,
+ * it, and F would measure that instead. Along a periodic axis, the vertex's power circle
+ * grown by R_max must lie in the box of the ghosts: a site left out cuts the cell only
+ * if it is nearer in power than p to one of its vertices (laguerre.c, cell_complete). */
+int quality_cell_inside(const quality_frame *frame, const gp_disk *disks, int32_t i,
                         const int32_t *ring, size_t degree)
 {
+    const gp_domain *domain = frame->domain;
     const gp_disk *p = &disks[i];
+    int answer = 1;
     for (size_t k = 0; k < degree; k++) {
         const gp_disk *a = &disks[ring[k]], *b = &disks[ring[(k + 1) % degree]];
         /* the power vertex o = p + u solves u.(a - p) = ca and u.(b - p) = cb, where
@@ -28,18 +42,35 @@ int quality_cell_inside(const gp_domain *domain, const gp_disk *disks, int32_t i
         double det = ax * by - ay * bx;
         if (!(det > 0.0))
             return 0;
-        double ox = p->x + (ca * by - cb * ay) / det, oy = p->y + (ax * cb - bx * ca) / det;
-        if (!(ox >= 0.0 && oy >= 0.0 && ox <= domain->width && oy <= domain->height))
+        double ux = (ca * by - cb * ay) / det, uy = (ax * cb - bx * ca) / det;
+        double ox = p->x + ux, oy = p->y + uy;
+        if (!domain->periodic) {
+            if (!(ox >= 0.0 && oy >= 0.0 && ox <= domain->width && oy <= domain->height))
+                return 0;
+            continue;
+        }
+        double pow_o = ux * ux + uy * uy - p->R * p->R;
+        double reach = sqrt((pow_o > 0.0 ? pow_o : 0.0) + frame->R_max * frame->R_max);
+        int in_x = axis_inside(domain->periodic & GP_PERIODIC_X, ox, domain->width, frame->box, reach);
+        int in_y = axis_inside(domain->periodic & GP_PERIODIC_Y, oy, domain->height, frame->box, reach);
+        if (!in_x || !in_y)
             return 0;
+        if (in_x < 0 || in_y < 0)
+            answer = QUALITY_INCOMPLETE;
     }
-    return 1;
+    return answer;
 }
 
-double quality_of_centre(const gp_domain *domain, const gp_disk *disks, int32_t i,
-                         const int32_t *ring, size_t degree, int on_hull)
+double quality_of_centre(const quality_frame *frame, const gp_disk *disks, int32_t i,
+                         const int32_t *ring, size_t degree, int on_hull, int *incomplete)
 {
-    if (on_hull || degree < 3 || !quality_cell_inside(domain, disks, i, ring, degree))
+    if (on_hull || degree < 3)
         return NAN;
+    int inside = quality_cell_inside(frame, disks, i, ring, degree);
+    if (inside != 1) {
+        *incomplete |= inside == QUALITY_INCOMPLETE;
+        return NAN;
+    }
     const gp_disk *p = &disks[i];
     double h_min = INFINITY, h_max = -INFINITY;
     for (size_t k = 0; k < degree; k++) {
@@ -79,38 +110,77 @@ void quality_summarise(const double *F, size_t n, int histogram, gp_quality_stat
     }
 }
 
-int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
-               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err)
+/* F into values[0..n-1] for the first n vertices of rt, triangulated from `disks`; sets
+ * *incomplete as quality_of_centre does. Returns 0, GP_ENOMEM or GP_ECANCELED with err. */
+static int measure_all(const quality_frame *frame, const gp_rt *rt, const gp_disk *disks, size_t n,
+                       double *values, int *incomplete, const gp_cancel_flag *cancel, gp_error *err)
 {
-    memset(stats, 0, sizeof *stats);
     size_t cap = 64;
     int32_t *ring = malloc(cap * sizeof *ring);
-    double *values = F ? F : malloc((n ? n : 1) * sizeof *values);
     int rc = 0;
-    if (!ring || !values) {
-        rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory measuring F on %zu disks", n);
-        goto done;
-    }
+    if (!ring)
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for a ring");
     for (size_t i = 0; i < n; i++) {
         if (i % GP_QUALITY_CENTRES_PER_CHECK == GP_QUALITY_CENTRES_PER_CHECK - 1 && gp_canceled(cancel)) {
             rc = gp_error_set(err, GP_ECANCELED, NULL, "measuring F canceled");
-            goto done;
+            break;
         }
         int hull;
         size_t degree;
         while ((degree = gp_rt_ring(rt, (int32_t)i, ring, cap, &hull)) > cap) {
             int32_t *grown = grow(ring, &cap, degree, sizeof *grown);
             if (!grown) {
-                rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for a ring");
-                goto done;
+                free(ring);
+                return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for a ring");
             }
             ring = grown;
         }
-        values[i] = quality_of_centre(domain, disks, (int32_t)i, ring, degree, hull);
+        values[i] = quality_of_centre(frame, disks, (int32_t)i, ring, degree, hull, incomplete);
     }
-    quality_summarise(values, n, 1, stats);
-done:
     free(ring);
+    return rc;
+}
+
+/* F on a periodic domain: from a ghost layer whose margin doubles until every cell is
+ * complete (docs/method.md §4.2, §5.1). */
+static int measure_periodic(const gp_domain *domain, const gp_disk *disks, size_t n, double *values,
+                            const gp_cancel_flag *cancel, gp_error *err)
+{
+    double R_max = 0.0;
+    for (size_t i = 0; i < n; i++)
+        R_max = disks[i].R > R_max ? disks[i].R : R_max;
+    gp_progress progress = {NULL, NULL, cancel};
+    for (double margin = periodic_first_margin(domain, R_max);; margin *= 2.0) {
+        double last = periodic_last_margin(domain);
+        margin = margin < last ? margin : last;
+        periodic_layer L;
+        int rc = periodic_layer_build(&L, domain, disks, n, margin, &progress, err);
+        if (rc)
+            return rc;
+        quality_frame frame = {domain, margin, R_max};
+        int incomplete = 0;
+        rc = measure_all(&frame, L.rt, L.all, n, values, &incomplete, cancel, err);
+        periodic_layer_free(&L);
+        if (rc || !incomplete)
+            return rc;
+        if (margin >= last)
+            return periodic_too_small(err);
+    }
+}
+
+int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n, double *F,
+               gp_quality_stats *stats, const gp_cancel_flag *cancel, gp_error *err)
+{
+    memset(stats, 0, sizeof *stats);
+    double *values = F ? F : malloc((n ? n : 1) * sizeof *values);
+    if (!values)
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory measuring F on %zu disks", n);
+    quality_frame frame = {domain, 0.0, 0.0};
+    int incomplete = 0;
+    int rc = domain->periodic ? measure_periodic(domain, disks, n, values, cancel, err)
+                              : measure_all(&frame, rt, disks, n, values, &incomplete, cancel, err);
+    if (rc == 0)
+        quality_summarise(values, n, 1, stats);
     if (values != F)
         free(values);
     return rc;

@@ -199,6 +199,10 @@ static void encode_mesh(enc *e, const gp_mesh *m)
     put_f64(e, s->band_thickness_min);
     put_f64(e, s->band_thickness_mean);
     put_u64(e, s->refused_refinements);
+    /* added after the first stored meshes: read only when present */
+    put_u64(e, s->periodic_pairs[0]);
+    put_u64(e, s->periodic_pairs[1]);
+    put_u32(e, (uint32_t)s->rounds);
 }
 
 /* Adds a section: borrowed bytes (e == NULL), or the encoder's (taken over). */
@@ -503,6 +507,11 @@ static int decode_mesh(dec *d, gp_result *r)
     s->band_thickness_min = get_f64(d);
     s->band_thickness_mean = get_f64(d);
     s->refused_refinements = get_size(d);
+    if (d->left > 0) { /* a mesh stored before the periodic pairs had none */
+        s->periodic_pairs[0] = get_size(d);
+        s->periodic_pairs[1] = get_size(d);
+        s->rounds = (int)get_u32(d);
+    }
     r->has_mesh = !d->failed;
     return 0;
 }

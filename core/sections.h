@@ -16,7 +16,8 @@
  *   "cell_area"       per grain: its cell's area (f64)
  *   "cell_neighbours" per neighbour: its grain id (i32), cell after cell
  *   "mesh"            the mesh's summary: kind, order, counts, each region's polygon area,
- *                     gp_mesh_stats
+ *                     gp_mesh_stats (its periodic node pairs and rounds last: a summary
+ *                     stored before them ends without, and reads as 0)
  *   "mesh_xy"         per node: x, y (f64 each)
  *   "mesh_tri"        per triangle: its 3 (order 1) or 6 (order 2) node indices (i32)
  *   "mesh_tri_region" per triangle: its region (i32)

@@ -10,19 +10,15 @@
 #include <string.h>
 
 #include "grow.h"
+#include "spec_parts.h"
 #include "grainpack/pack.h"
 
 /* Packing density assumed by the disk-count estimate: a little above what the front
  * reaches (0.80-0.88), so that the estimate errs on the high side. */
 #define EXPECTED_FILL 0.90
 
-typedef struct validator {
-    gp_error *err;
-    size_t max_disks, max_bins, max_elements;
-} validator;
-
 /* Appends "/" + key (escaped per RFC 6901) to base. */
-static void pointer_key(char *out, const char *base, const char *key)
+void spec_pointer_key(char *out, const char *base, const char *key)
 {
     size_t n = (size_t)snprintf(out, GP_ERROR_POINTER_MAX, "%s/", base);
     for (const char *k = key; *k && n + 3 < GP_ERROR_POINTER_MAX; k++) {
@@ -43,7 +39,7 @@ static void pointer_index(char *out, const char *base, size_t index)
 {
     char key[24];
     snprintf(key, sizeof key, "%zu", index);
-    pointer_key(out, base, key);
+    spec_pointer_key(out, base, key);
 }
 
 static const char *type_phrase(const json_t *v)
@@ -62,8 +58,8 @@ static const char *type_phrase(const json_t *v)
 }
 
 /* Rejects members of obj not in the NULL-terminated list `allowed`. */
-static int check_members(validator *v, const json_t *obj, const char *base,
-                         const char *const *allowed, const char *expected_list)
+int spec_check_members(validator *v, const json_t *obj, const char *base,
+                       const char *const *allowed, const char *expected_list)
 {
     const char *key;
     json_t *value;
@@ -73,7 +69,7 @@ static int check_members(validator *v, const json_t *obj, const char *base,
             known |= strcmp(*a, key) == 0;
         if (!known) {
             char ptr[GP_ERROR_POINTER_MAX];
-            pointer_key(ptr, base, key);
+            spec_pointer_key(ptr, base, key);
             return gp_error_set(v->err, GP_EINVAL, ptr, "unknown field; expected one of %s",
                                 expected_list);
         }
@@ -81,10 +77,10 @@ static int check_members(validator *v, const json_t *obj, const char *base,
     return 0;
 }
 
-static int get_object(validator *v, const json_t *parent, const char *base, const char *key,
-                      int required, const json_t **out, char *ptr)
+int spec_get_object(validator *v, const json_t *parent, const char *base, const char *key,
+                    int required, const json_t **out, char *ptr)
 {
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(parent, key);
     *out = NULL;
     if (!value) {
@@ -99,11 +95,11 @@ static int get_object(validator *v, const json_t *parent, const char *base, cons
 }
 
 /* Reads a required finite number that must be > lower (or >= lower when `inclusive`). */
-static int get_number(validator *v, const json_t *obj, const char *base, const char *key,
-                      double lower, int inclusive, double *out)
+int spec_get_number(validator *v, const json_t *obj, const char *base, const char *key,
+                    double lower, int inclusive, double *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     const char *bound = inclusive ? ">=" : ">";
     if (!value)
@@ -122,7 +118,7 @@ static int get_finite(validator *v, const json_t *obj, const char *base, const c
                       double *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     if (!value)
         return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected a number");
@@ -137,7 +133,7 @@ static int get_choice(validator *v, const json_t *obj, const char *base, const c
                       const char *const *names, const char *expected_list, int *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     if (!value)
         return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected one of %s", expected_list);
@@ -160,7 +156,7 @@ static int parse_periodic(validator *v, const json_t *obj, const char *base, uns
 {
     static const char expected[] = "true, false or an array of distinct \"x\", \"y\"";
     char ptr[GP_ERROR_POINTER_MAX], item_ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, "periodic");
+    spec_pointer_key(ptr, base, "periodic");
     const json_t *value = json_object_get(obj, "periodic");
     *out = 0;
     if (!value || json_is_false(value))
@@ -193,15 +189,15 @@ static int parse_domain(validator *v, const json_t *inputs, const char *base, gp
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "domain", 1, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "domain", 1, &obj, ptr);
     if (rc)
         return rc;
     static const char *const members[] = {"width", "height", "periodic", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "width, height, periodic")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "width, height, periodic")))
         return rc;
-    if ((rc = get_number(v, obj, ptr, "width", 0.0, 0, &dom->width)))
+    if ((rc = spec_get_number(v, obj, ptr, "width", 0.0, 0, &dom->width)))
         return rc;
-    if ((rc = get_number(v, obj, ptr, "height", 0.0, 0, &dom->height)))
+    if ((rc = spec_get_number(v, obj, ptr, "height", 0.0, 0, &dom->height)))
         return rc;
     return parse_periodic(v, obj, ptr, &dom->periodic);
 }
@@ -209,7 +205,7 @@ static int parse_domain(validator *v, const json_t *inputs, const char *base, gp
 static int parse_histogram(validator *v, const json_t *obj, const char *base, gp_distribution *d)
 {
     char ptr[GP_ERROR_POINTER_MAX], bin_ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, "bins");
+    spec_pointer_key(ptr, base, "bins");
     const json_t *bins = json_object_get(obj, "bins");
     if (!bins)
         return gp_error_set(v->err, GP_EINVAL, ptr, "missing; expected an array of {min, max, p}");
@@ -236,19 +232,19 @@ static int parse_histogram(validator *v, const json_t *obj, const char *base, gp
         if (!json_is_object(bin))
             return gp_error_set(v->err, GP_EINVAL, bin_ptr, "must be an object {min, max, p}, got %s",
                                 type_phrase(bin));
-        if ((rc = check_members(v, bin, bin_ptr, members, "min, max, p")) ||
-            (rc = get_number(v, bin, bin_ptr, "min", 0.0, 0, &b->min)) ||
-            (rc = get_number(v, bin, bin_ptr, "max", b->min, 0, &b->max)) ||
-            (rc = get_number(v, bin, bin_ptr, "p", 0.0, 1, &b->p)))
+        if ((rc = spec_check_members(v, bin, bin_ptr, members, "min, max, p")) ||
+            (rc = spec_get_number(v, bin, bin_ptr, "min", 0.0, 0, &b->min)) ||
+            (rc = spec_get_number(v, bin, bin_ptr, "max", b->min, 0, &b->max)) ||
+            (rc = spec_get_number(v, bin, bin_ptr, "p", 0.0, 1, &b->p)))
             return rc;
         if (b->p > 1.0) {
             char p_ptr[GP_ERROR_POINTER_MAX];
-            pointer_key(p_ptr, bin_ptr, "p");
+            spec_pointer_key(p_ptr, bin_ptr, "p");
             return gp_error_set(v->err, GP_EINVAL, p_ptr, "must be <= 1, got %.17g", b->p);
         }
         if (i > 0 && b->min < d->bins[i - 1].max) {
             char min_ptr[GP_ERROR_POINTER_MAX];
-            pointer_key(min_ptr, bin_ptr, "min");
+            spec_pointer_key(min_ptr, bin_ptr, "min");
             return gp_error_set(v->err, GP_EINVAL, min_ptr,
                                 "must be >= the previous bin's max %.17g (bins sorted, not "
                                 "overlapping), got %.17g",
@@ -263,12 +259,12 @@ static int parse_histogram(validator *v, const json_t *obj, const char *base, gp
     return 0;
 }
 
-static int parse_distribution(validator *v, const json_t *inputs, const char *base,
-                              gp_distribution *d)
+int spec_parse_distribution(validator *v, const json_t *inputs, const char *base,
+                            gp_distribution *d)
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "distribution", 1, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "distribution", 1, &obj, ptr);
     if (rc)
         return rc;
     static const char *const kinds[] = {"constant", "uniform", "histogram", NULL};
@@ -279,21 +275,21 @@ static int parse_distribution(validator *v, const json_t *inputs, const char *ba
     switch (d->kind) {
     case GP_DIST_CONSTANT: {
         static const char *const members[] = {"kind", "radius", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "kind, radius")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "kind, radius")))
             return rc;
-        return get_number(v, obj, ptr, "radius", 0.0, 0, &d->radius);
+        return spec_get_number(v, obj, ptr, "radius", 0.0, 0, &d->radius);
     }
     case GP_DIST_UNIFORM: {
         static const char *const members[] = {"kind", "min", "max", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "kind, min, max")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "kind, min, max")))
             return rc;
-        if ((rc = get_number(v, obj, ptr, "min", 0.0, 0, &d->min)))
+        if ((rc = spec_get_number(v, obj, ptr, "min", 0.0, 0, &d->min)))
             return rc;
-        return get_number(v, obj, ptr, "max", d->min, 0, &d->max);
+        return spec_get_number(v, obj, ptr, "max", d->min, 0, &d->max);
     }
     case GP_DIST_HISTOGRAM: {
         static const char *const members[] = {"kind", "bins", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "kind, bins")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "kind, bins")))
             return rc;
         return parse_histogram(v, obj, ptr, d);
     }
@@ -301,11 +297,11 @@ static int parse_distribution(validator *v, const json_t *inputs, const char *ba
     return 0;
 }
 
-static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_joint *j)
+int spec_parse_joint(validator *v, const json_t *inputs, const char *base, gp_joint *j)
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "joint", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "joint", 0, &obj, ptr);
     memset(j, 0, sizeof *j);
     if (rc || !obj)
         return rc;
@@ -317,25 +313,25 @@ static int parse_joint(validator *v, const json_t *inputs, const char *base, gp_
     switch (j->law) {
     case GP_JOINT_NONE: {
         static const char *const members[] = {"law", NULL};
-        return check_members(v, obj, ptr, members, "law");
+        return spec_check_members(v, obj, ptr, members, "law");
     }
     case GP_JOINT_CONSTANT: {
         static const char *const members[] = {"law", "value", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "law, value")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "law, value")))
             return rc;
-        return get_number(v, obj, ptr, "value", 0.0, 1, &j->value);
+        return spec_get_number(v, obj, ptr, "value", 0.0, 1, &j->value);
     }
     case GP_JOINT_INVERSE: {
         static const char *const members[] = {"law", "k", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "law, k")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "law, k")))
             return rc;
-        return get_number(v, obj, ptr, "k", 0.0, 1, &j->k);
+        return spec_get_number(v, obj, ptr, "k", 0.0, 1, &j->k);
     }
     case GP_JOINT_POWER: {
         static const char *const members[] = {"law", "k", "exponent", NULL};
-        if ((rc = check_members(v, obj, ptr, members, "law, k, exponent")))
+        if ((rc = spec_check_members(v, obj, ptr, members, "law, k, exponent")))
             return rc;
-        if ((rc = get_number(v, obj, ptr, "k", 0.0, 1, &j->k)))
+        if ((rc = spec_get_number(v, obj, ptr, "k", 0.0, 1, &j->k)))
             return rc;
         return get_finite(v, obj, ptr, "exponent", &j->exponent);
     }
@@ -352,13 +348,13 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
 {
     char ptr[GP_ERROR_POINTER_MAX], band_ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "front", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "front", 0, &obj, ptr);
     *band = 0;
     *band_set = 0;
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"rule", "level_band", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "rule, level_band")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "rule, level_band")))
         return rc;
     const json_t *value = json_object_get(obj, "level_band");
     /* a level band alone asks for the report's rule, as it did before the rule existed */
@@ -369,7 +365,7 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
     *band_set = rule == 1;
     if (!value)
         return 0;
-    pointer_key(band_ptr, ptr, "level_band");
+    spec_pointer_key(band_ptr, ptr, "level_band");
     if (rule != 1)
         return gp_error_set(v->err, GP_EINVAL, band_ptr,
                             "only with \"rule\": \"level_band\" (the densest rule sets its own)");
@@ -388,7 +384,7 @@ static int parse_front(validator *v, const json_t *inputs, const char *base, uin
 static int get_bool(validator *v, const json_t *obj, const char *base, const char *key, int *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     if (!value)
         return 0;
@@ -402,11 +398,11 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
 {
     char ptr[GP_ERROR_POINTER_MAX], member[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "balance", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "balance", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"method", "max_iterations", "max_step", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "method, max_iterations, max_step")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "method, max_iterations, max_step")))
         return rc;
     static const char *const methods[] = {"none", "laplacian", "relocation", NULL};
     int method;
@@ -419,7 +415,7 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
     spec->balance.update = GP_RT_UPDATE_FLIPS;
     const json_t *value = json_object_get(obj, "max_iterations");
     if (value) {
-        pointer_key(member, ptr, "max_iterations");
+        spec_pointer_key(member, ptr, "max_iterations");
         if (!json_is_integer(value))
             return gp_error_set(v->err, GP_EINVAL, member, "must be an integer from 1 to %d, got %s",
                                 GP_SPEC_MAX_BALANCE_ITERATIONS, type_phrase(value));
@@ -431,10 +427,10 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
     }
     if (json_object_get(obj, "max_step")) {
         /* the steps tried go down by 0.05 to 0.05 (docs/method.md §4.4): a smaller first step tries none */
-        if ((rc = get_number(v, obj, ptr, "max_step", 0.05, 1, &spec->balance.max_step)))
+        if ((rc = spec_get_number(v, obj, ptr, "max_step", 0.05, 1, &spec->balance.max_step)))
             return rc;
         if (spec->balance.max_step > 1.0) {
-            pointer_key(member, ptr, "max_step");
+            spec_pointer_key(member, ptr, "max_step");
             return gp_error_set(v->err, GP_EINVAL, member, "must be <= 1 (the whole way to the target), got %.17g",
                                 spec->balance.max_step);
         }
@@ -446,11 +442,11 @@ static int parse_laguerre(validator *v, const json_t *inputs, const char *base, 
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "laguerre", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "laguerre", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"shrink", "flush_boundary", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "shrink, flush_boundary")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "shrink, flush_boundary")))
         return rc;
     static const char *const shrinks[] = {"none", "homothetic", "offset", NULL};
     int shrink;
@@ -466,7 +462,7 @@ static int get_bounded(validator *v, const json_t *obj, const char *base, const 
                        double lower, int open_lower, double upper, double *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     if (!value)
         return 0;
@@ -487,7 +483,7 @@ static int get_integer(validator *v, const json_t *obj, const char *base, const 
                        int lower, int upper, int *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, key);
+    spec_pointer_key(ptr, base, key);
     const json_t *value = json_object_get(obj, key);
     if (!value)
         return 0;
@@ -506,7 +502,7 @@ static int get_integer(validator *v, const json_t *obj, const char *base, const 
 static int get_min_angle(validator *v, const json_t *obj, const char *base, double *out)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, "min_angle");
+    spec_pointer_key(ptr, base, "min_angle");
     const json_t *value = json_object_get(obj, "min_angle");
     if (value && json_is_number(value) && json_number_value(value) > GP_MESH_MAX_MIN_ANGLE)
         return gp_error_set(v->err, GP_EINVAL, ptr,
@@ -523,11 +519,11 @@ static int parse_abaqus(validator *v, const json_t *mesh, const char *base, gp_m
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, mesh, base, "abaqus", 0, &obj, ptr);
+    int rc = spec_get_object(v, mesh, base, "abaqus", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"plane", "reduced_integration", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "plane, reduced_integration")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "plane, reduced_integration")))
         return rc;
     if (json_object_get(obj, "plane")) {
         static const char *const planes[] = {"stress", "strain", NULL};
@@ -543,12 +539,12 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
 {
     char ptr[GP_ERROR_POINTER_MAX], member[GP_ERROR_POINTER_MAX];
     const json_t *obj;
-    int rc = get_object(v, inputs, base, "mesh", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "mesh", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"element_size", "min_angle", "order", "band_layers",
                                           "band_size", "grading", "disk_tolerance", "abaqus", NULL};
-    if ((rc = check_members(v, obj, ptr, members,
+    if ((rc = spec_check_members(v, obj, ptr, members,
                             "element_size, min_angle, order, band_layers, band_size, grading, "
                             "disk_tolerance, abaqus")))
         return rc;
@@ -565,7 +561,7 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
         (rc = parse_abaqus(v, obj, ptr, m)))
         return rc;
     if (m->band_layers > 0 && (!spec->laguerre_enabled || spec->laguerre.shrink != GP_SHRINK_OFFSET)) {
-        pointer_key(member, ptr, "band_layers");
+        spec_pointer_key(member, ptr, "band_layers");
         return gp_error_set(v->err, GP_EINVAL, member,
                             "needs \"laguerre\": {\"shrink\": \"offset\"} (the band's strips have "
                             "parallel sides only between offset cells)");
@@ -574,18 +570,18 @@ static int parse_mesh(validator *v, const json_t *inputs, const char *base, gp_s
     static const char *const band_options[] = {"band_size", "grading"};
     for (size_t k = 0; k < sizeof band_options / sizeof *band_options; k++)
         if (json_object_get(obj, band_options[k]) && !band) {
-            pointer_key(member, ptr, band_options[k]);
+            spec_pointer_key(member, ptr, band_options[k]);
             return gp_error_set(v->err, GP_EINVAL, member,
                                 "sizes the grain-boundary band: it needs \"laguerre\": {\"shrink\": "
                                 "\"offset\"} or \"homothetic\"");
         }
     if (json_object_get(obj, "band_size") && !m->grading && m->band_layers == 0) {
-        pointer_key(member, ptr, "band_size");
+        spec_pointer_key(member, ptr, "band_size");
         return gp_error_set(v->err, GP_EINVAL, member, "sizes nothing with \"grading\": false and no "
                                                        "band_layers");
     }
     if (json_object_get(obj, "disk_tolerance") && spec->laguerre_enabled) {
-        pointer_key(member, ptr, "disk_tolerance");
+        spec_pointer_key(member, ptr, "disk_tolerance");
         return gp_error_set(v->err, GP_EINVAL, member, "polygonises disks in a matrix: it has no "
                                                        "meaning with Laguerre cells");
     }
@@ -598,17 +594,17 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
     const json_t *obj;
     spec->picture_color = spec->balance_enabled ? GP_PICTURE_COLOR_QUALITY : GP_PICTURE_COLOR_RADIUS;
     spec->picture_tile = 1;
-    int rc = get_object(v, inputs, base, "picture", 0, &obj, ptr);
+    int rc = spec_get_object(v, inputs, base, "picture", 0, &obj, ptr);
     if (rc || !obj)
         return rc;
     static const char *const members[] = {"color", "disks", "tile", NULL};
-    if ((rc = check_members(v, obj, ptr, members, "color, disks, tile")))
+    if ((rc = spec_check_members(v, obj, ptr, members, "color, disks, tile")))
         return rc;
     if ((rc = get_integer(v, obj, ptr, "tile", 1, GP_PICTURE_MAX_TILE, &spec->picture_tile)))
         return rc;
     if (spec->picture_tile > 1 && !spec->domain.periodic) {
         char tile_ptr[GP_ERROR_POINTER_MAX];
-        pointer_key(tile_ptr, ptr, "tile");
+        spec_pointer_key(tile_ptr, ptr, "tile");
         return gp_error_set(v->err, GP_EINVAL, tile_ptr,
                             "tiles a periodic domain only; add \"periodic\" to the domain or leave "
                             "\"tile\" out");
@@ -619,7 +615,7 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
         if ((rc = get_choice(v, obj, ptr, "color", colors, "radius, quality", &color)))
             return rc;
         spec->picture_color = (gp_picture_color)color;
-        pointer_key(color_ptr, ptr, "color");
+        spec_pointer_key(color_ptr, ptr, "color");
         if (spec->picture_color == GP_PICTURE_COLOR_QUALITY && !spec->balance_enabled)
             return gp_error_set(v->err, GP_EINVAL, color_ptr,
                                 "\"quality\" needs the balance stage: add \"balance\": {\"method\": ...}");
@@ -627,10 +623,10 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
     return get_bool(v, obj, ptr, "disks", &spec->picture_disks);
 }
 
-static int parse_seed(validator *v, const json_t *inputs, const char *base, uint64_t *seed)
+int spec_parse_seed(validator *v, const json_t *inputs, const char *base, uint64_t *seed)
 {
     char ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(ptr, base, "seed");
+    spec_pointer_key(ptr, base, "seed");
     const json_t *value = json_object_get(inputs, "seed");
     *seed = GP_SPEC_DEFAULT_SEED;
     if (!value)
@@ -647,20 +643,20 @@ static int parse_seed(validator *v, const json_t *inputs, const char *base, uint
 
 /* The JSON pointer of the field giving the law's smallest radius, into out
  * (GP_ERROR_POINTER_MAX bytes). */
-static void smallest_radius_pointer(const char *base, const gp_distribution *dist, char *out)
+void spec_smallest_radius_pointer(const char *base, const gp_distribution *dist, char *out)
 {
     char law[GP_ERROR_POINTER_MAX], bins[GP_ERROR_POINTER_MAX], bin[GP_ERROR_POINTER_MAX];
-    pointer_key(law, base, "distribution");
+    spec_pointer_key(law, base, "distribution");
     switch (dist->kind) {
-    case GP_DIST_CONSTANT: pointer_key(out, law, "radius"); return;
-    case GP_DIST_UNIFORM: pointer_key(out, law, "min"); return;
+    case GP_DIST_CONSTANT: spec_pointer_key(out, law, "radius"); return;
+    case GP_DIST_UNIFORM: spec_pointer_key(out, law, "min"); return;
     case GP_DIST_HISTOGRAM: {
         size_t i = 0; /* bins are sorted: the first drawn one holds the smallest radius */
         while (i + 1 < dist->nbins && !(dist->bins[i].p > 0.0))
             i++;
-        pointer_key(bins, law, "bins");
+        spec_pointer_key(bins, law, "bins");
         pointer_index(bin, bins, i);
-        pointer_key(out, bin, "min");
+        spec_pointer_key(out, bin, "min");
         return;
     }
     }
@@ -726,9 +722,9 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
 {
     char dist_ptr[GP_ERROR_POINTER_MAX], joint_ptr[GP_ERROR_POINTER_MAX],
         domain_ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(dist_ptr, base, "distribution");
-    pointer_key(joint_ptr, base, "joint");
-    pointer_key(domain_ptr, base, "domain");
+    spec_pointer_key(dist_ptr, base, "distribution");
+    spec_pointer_key(joint_ptr, base, "joint");
+    spec_pointer_key(domain_ptr, base, "domain");
     double r_min, r_max, R_min, R_max;
     gp_distribution_support(&spec->dist, &r_min, &r_max);
     if (!(r_max > 0.0))
@@ -747,24 +743,13 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
     if (limit != GP_PACK_LAW_OK) {
         /* the joint is at fault when the grain radii alone are within the ratio */
         if (limit == GP_PACK_LAW_PERIOD)
-            pointer_key(v->err->pointer, domain_ptr, "periodic");
+            spec_pointer_key(v->err->pointer, domain_ptr, "periodic");
         else if (limit == GP_PACK_LAW_RATIO && r_max <= GP_PACK_MAX_RADIUS_RATIO * r_min)
             snprintf(v->err->pointer, sizeof v->err->pointer, "%s", joint_ptr);
         else
-            smallest_radius_pointer(base, &spec->dist, v->err->pointer);
+            spec_smallest_radius_pointer(base, &spec->dist, v->err->pointer);
         return GP_EINVAL;
     }
-    /* the stages that do not take a periodic domain yet (docs/method.md §3.8) */
-    static const char *const walled_only[] = {"balance", "mesh"};
-    int enabled[] = {spec->balance_enabled, spec->mesh_enabled};
-    for (size_t k = 0; k < sizeof enabled / sizeof enabled[0]; k++)
-        if (spec->domain.periodic && enabled[k]) {
-            char stage_ptr[GP_ERROR_POINTER_MAX];
-            pointer_key(stage_ptr, base, walled_only[k]);
-            return gp_error_set(v->err, GP_EINVAL, stage_ptr,
-                                "does not take a periodic domain yet; leave it out, or give the "
-                                "domain walls (no \"periodic\")");
-        }
     spec->expected_disks = gp_spec_expected_disks(&spec->domain, &spec->dist, &spec->joint);
     double bound = gp_spec_disk_bound(&spec->domain, &spec->dist, &spec->joint);
     if (!(bound <= (double)v->max_disks))
@@ -776,8 +761,16 @@ static int check_whole(validator *v, const char *base, gp_spec *spec)
     if (!spec->mesh_enabled)
         return 0;
     char size_ptr[GP_ERROR_POINTER_MAX], mesh_ptr[GP_ERROR_POINTER_MAX];
-    pointer_key(mesh_ptr, base, "mesh");
-    pointer_key(size_ptr, mesh_ptr, "element_size");
+    spec_pointer_key(mesh_ptr, base, "mesh");
+    if (spec->domain.periodic && spec->mesh.band_layers > 0) {
+        char layers_ptr[GP_ERROR_POINTER_MAX];
+        spec_pointer_key(layers_ptr, mesh_ptr, "band_layers");
+        return gp_error_set(v->err, GP_EINVAL, layers_ptr,
+                            "is not available on a periodic domain (the band's strips would be "
+                            "cut by the periodic sides); leave it out: the band is then meshed "
+                            "with triangles");
+    }
+    spec_pointer_key(size_ptr, mesh_ptr, "element_size");
     spec->expected_elements = gp_mesh_expected_elements(
         &spec->domain, &spec->dist, &spec->joint, spec->expected_disks, spec->laguerre_enabled,
         spec->laguerre.shrink, &spec->mesh);
@@ -801,7 +794,7 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         /* an OGC API - Processes execute request: outputs/response/subscriber are allowed
          * and have no effect on the packing */
         static const char *const members[] = {"inputs", "outputs", "response", "subscriber", NULL};
-        int rc = check_members(v, root, "", members, "inputs, outputs, response, subscriber");
+        int rc = spec_check_members(v, root, "", members, "inputs, outputs, response, subscriber");
         if (rc)
             return rc;
         if (!json_is_object(wrapped))
@@ -813,13 +806,13 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
     static const char *const members[] = {"domain", "distribution", "joint", "seed", "front",
                                           "balance", "laguerre", "mesh", "picture", NULL};
     int rc;
-    if ((rc = check_members(v, inputs, base, members,
+    if ((rc = spec_check_members(v, inputs, base, members,
                             "domain, distribution, joint, seed, front, balance, laguerre, mesh, "
                             "picture")) ||
         (rc = parse_domain(v, inputs, base, &spec->domain)) ||
-        (rc = parse_distribution(v, inputs, base, &spec->dist)) ||
-        (rc = parse_joint(v, inputs, base, &spec->joint)) ||
-        (rc = parse_seed(v, inputs, base, &spec->seed)) ||
+        (rc = spec_parse_distribution(v, inputs, base, &spec->dist)) ||
+        (rc = spec_parse_joint(v, inputs, base, &spec->joint)) ||
+        (rc = spec_parse_seed(v, inputs, base, &spec->seed)) ||
         (rc = parse_front(v, inputs, base, &spec->level_band, &spec->level_band_set)) ||
         (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
         (rc = parse_mesh(v, inputs, base, spec)) ||
@@ -830,18 +823,20 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
     return 0;
 }
 
-int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
-                  gp_error *err)
+/* Sets up the validator for `limits` (NULL: the defaults) and parses the text: 0 with
+ * *root the caller's (json_decref), or GP_EPARSE with err set. */
+static int load_json(const char *text, size_t len, const gp_spec_limits *limits, gp_error *err,
+                     validator *v, json_t **root)
 {
-    memset(spec, 0, sizeof *spec);
-    validator v = {err, GP_SPEC_DEFAULT_MAX_DISKS, GP_SPEC_DEFAULT_MAX_BINS,
-                   GP_SPEC_DEFAULT_MAX_ELEMENTS};
+    *root = NULL;
+    *v = (validator){err, GP_SPEC_DEFAULT_MAX_DISKS, GP_SPEC_DEFAULT_MAX_BINS,
+                     GP_SPEC_DEFAULT_MAX_ELEMENTS};
     if (limits && limits->max_disks)
-        v.max_disks = limits->max_disks;
+        v->max_disks = limits->max_disks;
     if (limits && limits->max_bins)
-        v.max_bins = limits->max_bins;
+        v->max_bins = limits->max_bins;
     if (limits && limits->max_elements)
-        v.max_elements = limits->max_elements;
+        v->max_elements = limits->max_elements;
     /* jansson reads a NUL byte between tokens as if it were white space; JSON has none */
     const char *nul = memchr(text, '\0', len);
     if (nul)
@@ -850,12 +845,35 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
     json_error_t jerr;
     /* any JSON value is well-formed: `null` or `5` is valid JSON that is not a spec, so
      * it is refused as invalid (with what it is), not as malformed */
-    json_t *root = json_loadb(text, len, JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, &jerr);
-    if (!root)
+    *root = json_loadb(text, len, JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, &jerr);
+    if (!*root)
         return gp_error_set(err, GP_EPARSE, "", "line %d, column %d: %s", jerr.line, jerr.column,
                             jerr.text);
-    int rc = parse_root(&v, root, spec);
+    return 0;
+}
+
+int spec_parse_text(const char *text, size_t len, const gp_spec_limits *limits, gp_error *err,
+                    int (*parse)(validator *v, const json_t *root, void *spec), void *spec)
+{
+    validator v;
+    json_t *root = NULL;
+    int rc = load_json(text, len, limits, err, &v, &root);
+    if (rc == 0)
+        rc = parse(&v, root, spec);
     json_decref(root);
+    return rc;
+}
+
+static int parse_root_2d(validator *v, const json_t *root, void *spec)
+{
+    return parse_root(v, root, spec);
+}
+
+int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
+                  gp_error *err)
+{
+    memset(spec, 0, sizeof *spec);
+    int rc = spec_parse_text(text, len, limits, err, parse_root_2d, spec);
     if (rc)
         gp_spec_free(spec);
     return rc;
@@ -865,10 +883,10 @@ int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp
  * hundred bytes to a few megabytes (a long histogram); the buffer doubles as it fills. */
 #define READ_CHUNK 4096
 
-int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
-                      gp_error *err)
+int gp_spec_read_text(const char *path, char **text_out, size_t *len_out, gp_error *err)
 {
-    memset(spec, 0, sizeof *spec);
+    *text_out = NULL;
+    *len_out = 0;
     FILE *f = fopen(path, "rb");
     if (!f)
         return gp_error_set(err, GP_EIO, NULL, "cannot open %s: %s", path, strerror(errno));
@@ -891,10 +909,39 @@ int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *s
         }
     }
     fclose(f);
+    if (rc) {
+        free(text);
+        return rc;
+    }
+    *text_out = text;
+    *len_out = len;
+    return 0;
+}
+
+int spec_load_file(const char *path, const gp_spec_limits *limits, gp_error *err,
+                   int (*parse)(const char *text, size_t len, const gp_spec_limits *limits,
+                                void *spec, gp_error *err),
+                   void *spec)
+{
+    char *text;
+    size_t len;
+    int rc = gp_spec_read_text(path, &text, &len, err);
     if (rc == 0)
-        rc = gp_spec_parse(text, len, limits, spec, err);
+        rc = parse(text, len, limits, spec, err);
     free(text);
     return rc;
+}
+
+static int parse_2d(const char *text, size_t len, const gp_spec_limits *limits, void *spec, gp_error *err)
+{
+    return gp_spec_parse(text, len, limits, spec, err);
+}
+
+int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
+                      gp_error *err)
+{
+    memset(spec, 0, sizeof *spec);
+    return spec_load_file(path, limits, err, parse_2d, spec);
 }
 
 gp_pack_params gp_spec_pack_params(const gp_spec *spec, size_t max_disks)

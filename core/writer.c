@@ -130,6 +130,11 @@ int gp_writer_run(gp_writer *w, gp_out *out, size_t want)
     return out->err;
 }
 
+const gp_error *gp_writer_error(const gp_writer *w)
+{
+    return &w->error;
+}
+
 int gp_write_result(gp_out *out, gp_format format, const gp_spec *spec, const gp_result *result)
 {
     gp_grain_source source = gp_grain_source_memory(result);

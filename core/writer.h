@@ -35,6 +35,7 @@ struct gp_writer {
     int overflow;            /* a plan added more than GP_WRITER_MAX_STEPS steps: a bug */
     void *state;             /* the format's own (malloc'd, freed with the writer) */
     void (*drop)(void *state); /* frees what the state holds besides itself, or NULL */
+    gp_error error;          /* why a step failed, when the writer knows (gp_writer_error) */
 };
 
 void gp_writer_text(gp_writer *w, gp_text_fn fn, int param);
@@ -47,5 +48,9 @@ int gp_plan_svg(gp_writer *w);
 int gp_plan_vtk(gp_writer *w);
 /* msh, inp and vtu: the whole file in one text step, from the result's mesh (io_mesh_plan.c). */
 int gp_plan_mesh(gp_writer *w);
+/* Whether `r` holds what `format` (msh, inp, vtu) reads of it: the mesh's arrays, and
+ * the grains' radii (vtu), or the grains' arrays (vtu without a mesh). Returns 0, or
+ * GP_EINVAL with err saying what is missing. */
+int gp_mesh_result_check(const gp_result *r, gp_format format, gp_error *err);
 
 #endif

@@ -164,7 +164,10 @@ int gp_pg_claim(gp_db *d, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **s
     /* SKIP LOCKED: nodes claiming at once take different jobs instead of queueing on one */
     PGresult *res = gp_pg_query(
         db, "claim",
-        "UPDATE jobs SET status = 'running', started = $1, updated = $1, progress = 0,"
+        /* the time is this node's, read before the statement; the job's creation may be
+         * later (committed meanwhile, or another node's clock): never before it */
+        "UPDATE jobs SET status = 'running', started = GREATEST($1, created),"
+        " updated = GREATEST($1, created), progress = 0,"
         " message = 'running', claims = claims + 1, node = $2,"
         " lease_until = now() + make_interval(secs => $3::float8)"
         " WHERE seq = (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1"

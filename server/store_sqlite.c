@@ -43,7 +43,10 @@ static const char *const stmt_sql[ST_COUNT_OF] = {
                 " WHEN 'successful' THEN 2 WHEN 'failed' THEN 3 ELSE 4 END)) & 1)"
                 " AND (?4 IS NULL OR owner = ?4)"
                 " ORDER BY seq DESC LIMIT ?3",
-    [ST_CLAIM] = "UPDATE jobs SET status = 'running', started = ?1, updated = ?1, progress = 0,"
+    /* the claim's time is read before it waits for the write lock, which the job's own
+     * insertion may hold: never before the job's creation */
+    [ST_CLAIM] = "UPDATE jobs SET status = 'running', started = max(?1, created),"
+                 " updated = max(?1, created), progress = 0,"
                  " message = 'running', claims = claims + 1"
                  " WHERE seq = (SELECT seq FROM jobs WHERE status = 'accepted' ORDER BY seq LIMIT 1)"
                  " RETURNING id, spec",

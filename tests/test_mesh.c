@@ -179,20 +179,34 @@ static void check_areas(const gp_mesh *m, const gp_domain *d)
 }
 
 /* Grain elements inside their cell (convex, counter-clockwise), all their nodes. */
-static void check_inside_cells(const gp_mesh *m, const gp_result *res)
+static void check_inside_cells(const gp_mesh *m, const gp_domain *domain, const gp_result *res)
 {
     if (!res->has_cells)
         return;
     const gp_cells *c = &res->cells;
+    /* periodic: an outline vertex may have been put on a side's line, as far as this */
+    double snap = 0.0;
+    for (size_t g = 0; domain->periodic && g < res->packing.count; g++)
+        snap += GP_MESH_SIDE_SNAP_RTOL * res->packing.disks[g].R / (double)res->packing.count;
     for (size_t t = 0; t < m->ntri; t++) {
         int32_t g = m->tri_region[t];
         if ((size_t)g >= m->ngrains)
             continue;
         const double *v = c->xy + 2 * c->start[g];
         size_t n = c->start[g + 1] - c->start[g];
-        double tol = INSIDE_RTOL * res->packing.disks[g].R;
+        const gp_disk *d = &res->packing.disks[g];
+        double tol = INSIDE_RTOL * d->R + snap;
+        /* periodic: the translate of the triangle nearest its grain's centre (a piece of a
+           cell across a side lies on the other side, the cell in unwrapped coordinates) */
+        const int32_t *tc = element(m, 0, t);
+        double cx = (m->xy[2 * tc[0]] + m->xy[2 * tc[1]] + m->xy[2 * tc[2]]) / 3.0;
+        double cy = (m->xy[2 * tc[0] + 1] + m->xy[2 * tc[1] + 1] + m->xy[2 * tc[2] + 1]) / 3.0;
+        double sx = cx - d->x, sy = cy - d->y;
+        gp_domain_min_image(domain, &sx, &sy);
+        sx = d->x + sx - cx;
+        sy = d->y + sy - cy;
         for (int k = 0; k < gp_mesh_tri_nodes(m->order); k++) {
-            double px = m->xy[2 * element(m, 0, t)[k]], py = m->xy[2 * element(m, 0, t)[k] + 1];
+            double px = m->xy[2 * tc[k]] + sx, py = m->xy[2 * tc[k] + 1] + sy;
             for (size_t i = 0; i < n; i++) {
                 double ax = v[2 * i], ay = v[2 * i + 1];
                 double bx = v[2 * ((i + 1) % n)], by = v[2 * ((i + 1) % n) + 1];
@@ -248,12 +262,31 @@ static double *suspects(const gp_spec *spec, const gp_result *res, size_t *n)
     return out;
 }
 
+/* Whether (x, y) lies within `reach` of the diametral circle of an element edge on a
+ * periodic side of the mesh. */
+static int near_periodic_side(const gp_mesh *m, const gp_domain *d, double x, double y, double reach)
+{
+    int stride = m->order + 1;
+    for (size_t b = 0; b < m->nbedges; b++) {
+        int side = m->bedge_side[b];
+        unsigned axis = side == GP_SIDE_LEFT || side == GP_SIDE_RIGHT ? GP_PERIODIC_X : GP_PERIODIC_Y;
+        if (!(d->periodic & axis))
+            continue;
+        const double *p = m->xy + 2 * m->bedge[stride * b], *q = m->xy + 2 * m->bedge[stride * b + 1];
+        double half = 0.5 * hypot(q[0] - p[0], q[1] - p[1]);
+        if (hypot(x - 0.5 * (p[0] + q[0]), y - 0.5 * (p[1] + q[1])) <= half + reach)
+            return 1;
+    }
+    return 0;
+}
+
 /* The angle bound: a triangle below it lies within SUSPECT_REACH circumradii of a
- * suspect point. Returns how many were excused. */
+ * suspect point, or of a periodic side (no more of those than refinements refused). Returns
+ * how many were excused. */
 static size_t check_angles(const gp_mesh *m, const gp_spec *spec, const gp_result *res)
 {
     double *near = NULL;
-    size_t nnear = 0, excused = 0;
+    size_t nnear = 0, excused = 0, by_sides = 0;
     for (size_t t = 0; t < m->ntri; t++) {
         const int32_t *c = element(m, 0, t);
         double lo = 180.0, l[3];
@@ -272,10 +305,19 @@ static size_t check_angles(const gp_mesh *m, const gp_spec *spec, const gp_resul
         int found = 0;
         for (size_t k = 0; k < nnear && !found; k++)
             found = hypot(near[2 * k] - x, near[2 * k + 1] - y) <= SUSPECT_REACH * R + l[0] + l[2];
+        /* periodic: the last round locks the sides, and the triangles whose circumcentre
+           would encroach a side's edge (it lies in the edge's diametral circle) are left
+           as they are (refused_refinements counts them) */
+        if (!found && spec->domain.periodic && near_periodic_side(m, &spec->domain, x, y, SUSPECT_REACH * R + l[0] + l[2])) {
+            found = 1;
+            by_sides++;
+        }
         CHECK_MSG(found, "triangle %zu at (%g, %g) has an angle of %g degrees, far from sharp input "
-                  "corners and strip ends", t, x, y, lo);
+                  "corners, strip ends and periodic sides", t, x, y, lo);
         excused++;
     }
+    CHECK_MSG(by_sides <= m->stats.refused_refinements, "%zu bad triangles by the periodic sides, "
+              "%zu refused refinements", by_sides, m->stats.refused_refinements);
     free(near);
     return excused;
 }
@@ -347,6 +389,108 @@ static void check_order2(const gp_mesh *m)
     }
 }
 
+static int by_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The coordinates along the side of the nodes on the line where coordinate `axis` is c,
+ * sorted; *n gets how many. */
+static double *side_nodes(const gp_mesh *m, int axis, double c, size_t *n)
+{
+    double *along = malloc((m->nnodes + 1) * sizeof *along);
+    *n = 0;
+    for (size_t k = 0; k < m->nnodes; k++)
+        if (m->xy[2 * k + axis] == c)
+            along[(*n)++] = m->xy[2 * k + 1 - axis];
+    qsort(along, *n, sizeof *along, by_double);
+    return along;
+}
+
+/* The area a cell may lose or gain when its vertices within GP_MESH_SIDE_SNAP_RTOL mean
+ * radii of a periodic side's line are put on it (mesh_geometry.c): the moves times the
+ * cell's perimeter; 0 when no vertex is that close. */
+static double snap_tolerance(const gp_result *res, const gp_domain *d, size_t g, double R_mean)
+{
+    const gp_cells *c = &res->cells;
+    const double *v = c->xy + 2 * c->start[g];
+    size_t n = c->start[g + 1] - c->start[g];
+    double eps = GP_MESH_SIDE_SNAP_RTOL * R_mean, moved = 0.0, perimeter = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        perimeter += hypot(v[2 * ((k + 1) % n)] - v[2 * k], v[2 * ((k + 1) % n) + 1] - v[2 * k + 1]);
+        for (int axis = 0; axis < 2; axis++) {
+            if (!(d->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)))
+                continue;
+            double x = v[2 * k + axis], period = axis == 0 ? d->width : d->height;
+            double off = fmin(fabs(x), fabs(x - period));
+            if (off <= eps)
+                moved += off;
+        }
+    }
+    return moved * perimeter;
+}
+
+/* A periodic mesh: along each periodic axis, the nodes on the two sides are translates
+ * of each other one to one, bit for bit, corners included (and the library's pairs are
+ * those); each grain's elements cover its whole outline, whose pieces lie on both sides
+ * of a periodic side: with cells, the area of its (unwrapped) cell; without, that of its
+ * polygonised disk, under the circle's and above 90% of it (a piece lost across a side
+ * would take more). A cell with a vertex put on a side's line (GP_MESH_SIDE_SNAP_RTOL)
+ * may differ by that move times its perimeter: at most one grain in ten is. */
+static void check_periodic(const gp_mesh *m, const gp_domain *d, const gp_result *res)
+{
+    for (int axis = 0; axis < 2; axis++) {
+        if (!(d->periodic & (axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y)))
+            continue;
+        size_t nlo, nhi;
+        double *lo = side_nodes(m, axis, 0.0, &nlo);
+        double *hi = side_nodes(m, axis, axis == 0 ? d->width : d->height, &nhi);
+        CHECK_MSG(nlo == nhi && nlo >= 2, "axis %d: %zu and %zu nodes on the sides", axis, nlo, nhi);
+        for (size_t k = 0; k < nlo && k < nhi; k++) {
+            CHECK_MSG(lo[k] == hi[k], "axis %d: node %zu at %.17g and %.17g", axis, k, lo[k], hi[k]);
+            CHECK(k == 0 || lo[k] > lo[k - 1]);
+        }
+        CHECK(nlo > 0 && lo[0] == 0.0 && lo[nlo - 1] == (axis == 0 ? d->height : d->width));
+        int32_t *pairs;
+        size_t n;
+        CHECK(gp_mesh_periodic_pairs(m, d, axis, &pairs, &n) == 0 && n == nlo);
+        for (size_t k = 0; k < n && k < nlo; k++)
+            CHECK(m->xy[2 * pairs[2 * k] + 1 - axis] == lo[k] &&
+                  m->xy[2 * pairs[2 * k + 1] + 1 - axis] == lo[k]);
+        CHECK((size_t)m->stats.periodic_pairs[axis] == nlo);
+        free(pairs);
+        free(lo);
+        free(hi);
+    }
+    double R_mean = 0.0;
+    size_t snapped_grains = 0;
+    for (size_t g = 0; g < m->ngrains; g++)
+        R_mean += res->packing.disks[g].R / (double)m->ngrains;
+    double *area = calloc(m->ngrains + 1, sizeof *area);
+    for (size_t t = 0; t < m->ntri; t++)
+        area[m->tri_region[t]] += gp_mesh_element_area(m, 0, t);
+    /* the outline is inscribed; its longest chord spans under four times the wedge angle
+       (two contacts closer than their two minimum steps, 2 x 2 x 21.1 degrees: a cap of
+       7.6% of the disk), the others at most 15.7 degrees (1.1% in all) */
+    double poly = 0.9;
+    for (size_t g = 0; g < m->ngrains; g++) {
+        if (res->has_cells) {
+            double tol = AREA_RTOL * fmax(res->cells.area[g], 1.0);
+            double snapped = snap_tolerance(res, d, g, R_mean);
+            CHECK_MSG(fabs(area[g] - res->cells.area[g]) <= tol + snapped,
+                      "grain %zu: elements %.17g, cell %.17g", g, area[g], res->cells.area[g]);
+            snapped_grains += snapped > 0.0;
+        } else {
+            double r = res->packing.disks[g].r, circle = M_PI * r * r;
+            CHECK_MSG(area[g] <= circle * (1.0 + 1e-9) && area[g] >= poly * circle,
+                      "grain %zu: elements %.17g, circle %.17g", g, area[g], circle);
+        }
+    }
+    free(area);
+    CHECK_MSG(snapped_grains * 10 <= m->ngrains, "%zu of %zu grains snapped to a side", snapped_grains, m->ngrains);
+}
+
 /* All the checks on one spec; returns the triangles excused from the angle bound. */
 static size_t check_case(const char *json)
 {
@@ -364,7 +508,9 @@ static size_t check_case(const char *json)
     edge_use_build(m, &u);
     check_conforming(m, &spec.domain, &u);
     check_areas(m, &spec.domain);
-    check_inside_cells(m, &res);
+    check_inside_cells(m, &spec.domain, &res);
+    if (spec.domain.periodic)
+        check_periodic(m, &spec.domain, &res);
     size_t excused = check_angles(m, &spec, &res);
     all_triangles += m->ntri;
     all_excused += excused;
@@ -442,6 +588,50 @@ static void test_mesh_band_layers(void)
     mesh_cases("\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 2}", SEEDS);
     mesh_cases("\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 1, \"order\": 2}", 2);
     mesh_cases("\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 4, \"band_size\": 0.3}", 2);
+}
+
+/* The reference laws on periodic domains (a period of at least 12 largest packing radii,
+ * docs/method.md §3.8), the torus and a strip periodic in x: iron, fixed, figure 4.7 and
+ * bagi's. %s: the domain's "periodic". */
+static const char *const periodic_laws[] = {
+    "\"domain\": {\"width\": 100, \"height\": 100, \"periodic\": %s}, \"distribution\": {\"kind\": "
+    "\"histogram\", \"bins\": [{\"min\": 2.0, \"max\": 3.0, \"p\": 0.37}, {\"min\": 3.0, \"max\": 4.0, \"p\": 0.38},"
+    "{\"min\": 4.0, \"max\": 6.0, \"p\": 0.23}, {\"min\": 6.0, \"max\": 8.0, \"p\": 0.02}]},"
+    "\"joint\": {\"law\": \"inverse\", \"k\": 2.0}, \"mesh\": {\"element_size\": 3",
+    "\"domain\": {\"width\": 15, \"height\": 12, \"periodic\": %s}, \"distribution\": {\"kind\": "
+    "\"constant\", \"radius\": 0.9}, \"joint\": {\"law\": \"constant\", \"value\": 0.1}, \"mesh\": {\"element_size\": 0.45",
+    "\"domain\": {\"width\": 12, \"height\": 12, \"periodic\": %s}, \"distribution\": {\"kind\": "
+    "\"histogram\", \"bins\": [{\"min\": 0.2, \"max\": 0.4, \"p\": 0.3}, {\"min\": 0.4, \"max\": 0.6, \"p\": 0.2},"
+    "{\"min\": 0.6, \"max\": 0.9, \"p\": 0.5}]}, \"joint\": {\"law\": \"constant\", \"value\": 0.1}, \"mesh\": {\"element_size\": 0.25",
+    "\"domain\": {\"width\": 6, \"height\": 6, \"periodic\": %s}, \"distribution\": {\"kind\": \"uniform\", "
+    "\"min\": 0.06, \"max\": 0.42}, \"mesh\": {\"element_size\": 0.3",
+};
+
+/* Every periodic law on the torus and on an x strip, `seeds` seeds, with `stage` (the
+ * cells, or none) and `mesh` (more of the mesh's members, after a comma, or ""). */
+static void periodic_cases(const char *stage, const char *mesh, int seeds)
+{
+    const char *axes[] = {"true", "[\"x\"]"};
+    for (size_t l = 0; l < sizeof periodic_laws / sizeof periodic_laws[0]; l++)
+        for (size_t a = 0; a < 2; a++)
+            for (int seed = 1; seed <= seeds; seed++) {
+                char law[1024], json[2048];
+                snprintf(law, sizeof law, periodic_laws[l], axes[a]);
+                snprintf(json, sizeof json, "{%s%s}, \"seed\": %d%s}", law, mesh, seed, stage);
+                check_case(json);
+            }
+}
+
+static void test_mesh_periodic_cells(void)
+{
+    periodic_cases(", \"laguerre\": {\"shrink\": \"offset\"}", "", 3);
+    periodic_cases(", \"laguerre\": {\"shrink\": \"none\"}", "", 2);
+    periodic_cases(", \"laguerre\": {\"shrink\": \"homothetic\"}", ", \"order\": 2", 1);
+}
+
+static void test_mesh_periodic_disks_in_matrix(void)
+{
+    periodic_cases("", "", 3);
 }
 
 /* The reference cases of examples/, at full size, meshed as grains and band. */
@@ -628,6 +818,8 @@ int main(void)
     RUN(test_mesh_cells_conform_across_cells);
     RUN(test_mesh_disks_in_matrix);
     RUN(test_mesh_band_layers);
+    RUN(test_mesh_periodic_cells);
+    RUN(test_mesh_periodic_disks_in_matrix);
     RUN(test_mesh_band_graded_to_its_thickness);
     RUN(test_mesh_reference_examples);
     RUN(test_mesh_cancel);

@@ -1,12 +1,13 @@
 /* test_output.c - statistics on hand-made packings, the writers (CSV read back exactly,
  * JSON parsed, SVG counted), and determinism: same seed, same bytes; other seed, other
- * bytes. */
+ * bytes; the mesh formats refuse a result without the mesh they read. */
 #include <jansson.h>
 #include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
 #include "grainpack/io.h"
+#include "grainpack/io_mesh.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/stats.h"
 #include "packing_checks.h"
@@ -270,6 +271,80 @@ static void test_format_names(void)
     CHECK_STR(gp_format_name(GP_FORMAT_VTK), "vtk");
 }
 
+/* Runs a writer of `format` on `result` (its grains from the result itself) to the end:
+ * its return code, and its own error in *err. */
+static int write_through(gp_format format, const gp_spec *spec, const gp_result *result, gp_error *err)
+{
+    gp_out out;
+    CHECK(gp_out_init(&out, 4096, NULL, NULL) == 0);
+    gp_grain_source source = gp_grain_source_memory(result);
+    gp_writer *w = gp_writer_new(format, spec, result, &source);
+    CHECK(w != NULL);
+    int rc = w ? gp_writer_run(w, &out, SIZE_MAX) : GP_ENOMEM;
+    if (w)
+        *err = *gp_writer_error(w);
+    gp_writer_free(w);
+    gp_out_free(&out);
+    return rc;
+}
+
+/* msh, inp and vtu of a result without the mesh (or without the arrays) they read fail
+ * with GP_EINVAL and a message, through the writer and the direct calls alike; the
+ * arrays are never read through NULL (which ASan would report). */
+static void test_mesh_formats_refuse_a_result_without_its_mesh(void)
+{
+    const char *plain = "{\"domain\": {\"width\": 12, \"height\": 12}, \"distribution\": "
+                        "{\"kind\": \"constant\", \"radius\": 1}, \"seed\": 3";
+    char json[512];
+    gp_spec spec, meshed_spec;
+    gp_result bare, meshed;
+    gp_error err;
+    snprintf(json, sizeof json, "%s}", plain);
+    CHECK(gp_spec_parse(json, strlen(json), NULL, &spec, &err) == 0);
+    CHECK(gp_pipeline_run(&spec, 0, NULL, &bare, &err) == 0);
+    snprintf(json, sizeof json, "%s, \"mesh\": {}}", plain);
+    CHECK(gp_spec_parse(json, strlen(json), NULL, &meshed_spec, &err) == 0);
+    CHECK(gp_pipeline_run(&meshed_spec, 0, NULL, &meshed, &err) == 0);
+    CHECK(!bare.has_mesh && meshed.has_mesh && meshed.mesh.ntri > 0);
+
+    /* no mesh stage: msh and inp refused, vtu writes the grains */
+    for (gp_format f = GP_FORMAT_MSH; f <= GP_FORMAT_INP; f++) {
+        CHECK(write_through(f, &spec, &bare, &err) == GP_EINVAL);
+        CHECK(err.code == GP_EINVAL && strstr(err.message, "needs a mesh") != NULL);
+    }
+    CHECK(write_through(GP_FORMAT_VTU, &spec, &bare, &err) == 0 && err.code == 0);
+    /* the meshed result whole: every format written, no error */
+    for (gp_format f = GP_FORMAT_MSH; f <= GP_FORMAT_VTU; f++)
+        CHECK(write_through(f, &meshed_spec, &meshed, &err) == 0 && err.code == 0);
+
+    /* a summary: the counts without the arrays (a shallow copy, never freed) */
+    gp_result summary = meshed;
+    summary.mesh.xy = NULL;
+    summary.mesh.tri = NULL;
+    for (gp_format f = GP_FORMAT_MSH; f <= GP_FORMAT_VTU; f++) {
+        CHECK(write_through(f, &meshed_spec, &summary, &err) == GP_EINVAL);
+        CHECK_MSG(err.code == GP_EINVAL && strstr(err.message, "arrays") != NULL, "%s: %s",
+                  gp_format_name(f), err.message);
+    }
+    gp_out out;
+    CHECK(gp_out_init(&out, 4096, NULL, NULL) == 0);
+    CHECK(gp_write_msh(&out, &meshed_spec, &summary) == GP_EINVAL);
+    CHECK(gp_write_inp(&out, &meshed_spec, &summary) == GP_EINVAL);
+    CHECK(gp_write_vtu(&out, &meshed_spec, &summary) == GP_EINVAL);
+    CHECK(gp_write_msh(&out, &spec, &bare) == GP_EINVAL);
+    /* vtu of grains whose arrays are not in the result */
+    summary = bare;
+    summary.packing.disks = NULL;
+    CHECK(write_through(GP_FORMAT_VTU, &spec, &summary, &err) == GP_EINVAL && err.code == GP_EINVAL);
+    CHECK(gp_write_vtu(&out, &spec, &summary) == GP_EINVAL);
+    gp_out_free(&out);
+
+    gp_result_free(&bare);
+    gp_result_free(&meshed);
+    gp_spec_free(&spec);
+    gp_spec_free(&meshed_spec);
+}
+
 int main(void)
 {
     RUN(test_statistics_of_a_hand_made_packing);
@@ -281,5 +356,6 @@ int main(void)
     RUN(test_svg_colours_by_F_with_its_legend);
     RUN(test_svg_draws_cells_on_the_band);
     RUN(test_stages_are_deterministic_too);
+    RUN(test_mesh_formats_refuse_a_result_without_its_mesh);
     return check_status();
 }

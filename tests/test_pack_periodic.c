@@ -181,19 +181,25 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", bad[i].domain);
         CHECK_STR(err.pointer, bad[i].pointer);
     }
-    /* the stages that do not take a periodic domain yet say so at their own field */
+    /* balancing and the mesh take a periodic domain; the mesh's band layers, which do
+     * not, say so at their own field */
     static const struct {
         const char *stage, *pointer;
-    } stages[] = {{"\"balance\": {\"method\": \"relocation\"}", "/balance"},
-                  {"\"mesh\": {\"element_size\": 1}", "/mesh"}};
+        int rc;
+    } stages[] = {{"\"balance\": {\"method\": \"relocation\"}", "", 0},
+                  {"\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"element_size\": 1}", "", 0},
+                  /* the band's strips would be cut by the periodic sides */
+                  {"\"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 2}",
+                   "/mesh/band_layers", GP_EINVAL}};
     for (size_t i = 0; i < sizeof stages / sizeof stages[0]; i++) {
         char json[512];
         snprintf(json, sizeof json,
                  "{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW ", %s}",
                  stages[i].stage);
         gp_error err;
-        CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", stages[i].stage);
-        CHECK_STR(err.pointer, stages[i].pointer);
+        CHECK_MSG(parse_error(json, &err) == stages[i].rc, "%s", stages[i].stage);
+        if (stages[i].rc)
+            CHECK_STR(err.pointer, stages[i].pointer);
     }
     /* a tiled picture needs a periodic domain, and at most GP_PICTURE_MAX_TILE copies */
     static const struct {
@@ -209,10 +215,12 @@ static void test_spec_field_and_its_errors(void)
         CHECK_MSG(parse_error(json, &err) == GP_EINVAL, "%s", json);
         CHECK_STR(err.pointer, "/picture/tile");
     }
-    /* the cells do take it (test_laguerre checks them) */
+    /* the cells and the mesh do take it (test_laguerre and test_mesh check them) */
     gp_error err;
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": true}, " LAW
                       ", \"laguerre\": {\"shrink\": \"offset\"}}", &err) == 0);
+    CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 30, \"periodic\": [\"x\"]}, " LAW
+                      ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {}}", &err) == 0);
     /* along a walled axis the short side is the walled rule's: one disk must fit */
     CHECK(parse_error("{\"domain\": {\"width\": 30, \"height\": 2.5, \"periodic\": [\"x\"]}, " LAW "}",
                       &err) == 0);

@@ -10,6 +10,7 @@
  * attempts allowed), the other node hears of jobs queued and finished. */
 #include <libpq-fe.h>
 #include <pthread.h>
+#include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,14 +28,20 @@ static char admin_uri[1024]; /* PostgreSQL: the server's maintenance database */
 static char dir[] = "/tmp/grainpack-contract-XXXXXX";
 static int databases; /* made so far, for their names */
 
-/* Runs one SQL command on the PostgreSQL server's maintenance database. */
-static void pg_admin(const char *sql)
+/* Runs one SQL command on a PostgreSQL database. */
+static void pg_exec(const char *uri, const char *sql)
 {
-    PGconn *conn = PQconnectdb(admin_uri);
+    PGconn *conn = PQconnectdb(uri);
     PGresult *res = PQexec(conn, sql);
     CHECK_MSG(PQresultStatus(res) == PGRES_COMMAND_OK, "%s: %s", sql, PQerrorMessage(conn));
     PQclear(res);
     PQfinish(conn);
+}
+
+/* Runs one SQL command on the PostgreSQL server's maintenance database. */
+static void pg_admin(const char *sql)
+{
+    pg_exec(admin_uri, sql);
 }
 
 /* A new empty database for one test: its location in `location`. */
@@ -151,6 +158,47 @@ static void test_jobs_are_claimed_oldest_first_and_results_read_back_whole(void)
           counts[GP_JOB_RUNNING] == 1 && counts[GP_JOB_ACCEPTED] == 0);
     CHECK(gp_store_healthy(db));
     gp_result_free(&r);
+    gp_spec_free(&spec);
+    gp_store_release(store, db);
+    gp_store_close(store);
+}
+
+/* Runs one SQL command on the current test's database, beside the store. */
+static void raw_sql(const char *sql)
+{
+    if (strcmp(backend, "sqlite") == 0) {
+        sqlite3 *conn = NULL;
+        char *why = NULL;
+        CHECK(sqlite3_open(location, &conn) == SQLITE_OK);
+        CHECK_MSG(sqlite3_exec(conn, sql, NULL, NULL, &why) == SQLITE_OK, "%s: %s", sql, why);
+        sqlite3_free(why);
+        sqlite3_close(conn);
+        return;
+    }
+    pg_exec(location, sql);
+}
+
+/* A worker reads the clock before its claim waits for the database (the job's own
+ * insertion may hold it, or the job came from a node whose clock is ahead): a job created
+ * after that reading is still never started before it was created. */
+static void test_a_job_is_never_started_before_it_was_created(void)
+{
+    new_database();
+    gp_store *store = open_store();
+    gp_db *db = gp_store_acquire(store, 1);
+    gp_spec spec = small_spec();
+    gp_job job, got;
+    CHECK(gp_store_insert_job(db, "", 0, "{}", 2, &spec, &job, NULL) == 0);
+    static const char later[] = "2999-01-01T00:00:00.000Z";
+    char sql[256];
+    snprintf(sql, sizeof sql, "UPDATE jobs SET created = '%s' WHERE id = '%s'", later, job.id);
+    raw_sql(sql);
+    char id[GP_JOB_ID_SIZE];
+    claim_one(db, id);
+    CHECK(strcmp(id, job.id) == 0);
+    CHECK(gp_store_get_job(db, id, NULL, &got) == 0 && got.status == GP_JOB_RUNNING);
+    CHECK_MSG(strcmp(got.started, got.created) >= 0, "started %s, created %s", got.started,
+              got.created);
     gp_spec_free(&spec);
     gp_store_release(store, db);
     gp_store_close(store);
@@ -456,6 +504,7 @@ int main(int argc, char **argv)
     RUN(test_a_location_is_logged_without_its_password);
     RUN(test_jobs_are_claimed_oldest_first_and_results_read_back_whole);
     RUN(test_a_job_dismissed_while_it_runs_keeps_no_result);
+    RUN(test_a_job_is_never_started_before_it_was_created);
     RUN(test_jobs_are_seen_by_their_owner_only);
     RUN(test_the_owner_limit_counts_accepted_and_running_jobs);
     RUN(test_threads_claiming_at_once_take_each_job_once);

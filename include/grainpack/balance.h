@@ -104,9 +104,13 @@ typedef struct gp_quality_stats {
  * triangulation has long thin triangles across the empty outside, and a centre touching
  * one has "neighbours" far along the wall whose gaps say nothing of the free space around
  * it. These centres (the layer along the walls) are also the ones balancing leaves in
- * place. F may be NULL when only the statistics are wanted. Returns 0, GP_ENOMEM or
- * GP_ECANCELED (*cancel, which may be NULL, is read every GP_QUALITY_CENTRES_PER_CHECK
- * centres). */
+ * place. F may be NULL when only the statistics are wanted.
+ * On a periodic domain (docs/method.md §4.7) `rt` is not used (it may be NULL): F is
+ * measured among all the periodic images, from a ghost layer and its own triangulation,
+ * and a centre is interior when its cell is inside the domain along the walled axes
+ * (every centre of a torus). Returns 0, GP_ENOMEM or GP_ECANCELED (*cancel, which may be
+ * NULL, is read every GP_QUALITY_CENTRES_PER_CHECK centres), or on a periodic domain a
+ * gp_rt_build error or GP_EGEOM (a cell reaches beyond a whole period of images). */
 GP_API int gp_quality(const gp_domain *domain, const gp_rt *rt, const gp_disk *disks, size_t n,
                       double *F, gp_quality_stats *stats, const gp_cancel_flag *cancel,
                       gp_error *err);
@@ -158,6 +162,13 @@ typedef struct gp_balance_result {
  * of the disks (gp_rt_build); it is borrowed and left up to date with the final
  * positions. F is measured before and after. Reports progress as stage "balance" and
  * honours progress->cancel.
+ *
+ * On a periodic domain (docs/method.md §4.7) `rt` is not used (it may be NULL): the sweeps
+ * run on a ghost layer of the disks and its own triangulation, each ghost moved with its
+ * disk; `params->update` GP_RT_UPDATE_FLIPS updates that triangulation by flips and makes
+ * the layer again only when a disk has drifted far, GP_RT_UPDATE_REBUILD makes the layer
+ * again every sweep (counted in triangulation.rebuilds either way). Overlaps are between
+ * nearest images, and the disks come back with their centres wrapped into the domain.
  *
  * On success returns 0 and `out` owns its F array (free with gp_balance_result_free).
  * On failure returns GP_ENOMEM, GP_ECANCELED, GP_ETOOBIG (bucket grid too large) or a

@@ -104,6 +104,12 @@ GP_API gp_writer *gp_writer_new(gp_format format, const gp_spec *spec,
  * done, or a negative code: out's error (GP_ENOMEM, the sink's) or the source's. */
 GP_API int gp_writer_run(gp_writer *w, gp_out *out, size_t want);
 
+/* Why the last gp_writer_run failed, when the writer itself refused (code GP_EINVAL: a
+ * result without the mesh or the arrays its format reads, e.g. msh of a job that asked
+ * for no mesh); code 0 when the failure was the sink's or the source's, or none. Owned
+ * by the writer. */
+GP_API const gp_error *gp_writer_error(const gp_writer *w);
+
 GP_API void gp_writer_free(gp_writer *w);
 
 /* Writes the whole result (in memory) in `format` into `out` and flushes it. Returns 0,

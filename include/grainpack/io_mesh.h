@@ -17,13 +17,14 @@ extern "C" {
 /* Gmsh MSH 4.1 (ASCII): one surface entity and physical group per region with elements
  * ("grain_<id>", "grain_boundary" or "matrix"), one curve entity and physical group per
  * domain side ("left", "right", "bottom", "top") with its line elements. Needs the mesh
- * stage: GP_EINVAL without it. Returns 0 or o->err. */
+ * stage and its arrays: GP_EINVAL without them (gp_writer_error says which). Returns 0 or
+ * o->err. */
 GP_API int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result);
 
 /* Abaqus input: nodes, elements (CPS3/CPS6/CPS4/CPS8 for plane stress, CPE* for plane
  * strain, R for reduced integration of quadrilaterals, as the spec asks), an element set
  * per grain ("grain_<id>") and for the second phase, a node set per domain side. Needs
- * the mesh stage (GP_EINVAL). */
+ * the mesh stage and its arrays (GP_EINVAL). */
 GP_API int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result);
 
 /* VTK XML unstructured grid (ASCII). With a mesh: its elements, with cell data region,
@@ -31,7 +32,7 @@ GP_API int gp_write_inp(gp_out *o, const gp_spec *spec, const gp_result *result)
  * second phase) and quality. Without one: the grains, as polygons when the job has
  * cells (cell data grain_id, radius, packing_radius, area, neighbours, F), else as
  * vertices at the disk centres (the same arrays as point data, without area and
- * neighbours). */
+ * neighbours). GP_EINVAL when the result lacks the arrays this reads. */
 GP_API int gp_write_vtu(gp_out *o, const gp_spec *spec, const gp_result *result);
 
 #ifdef __cplusplus

@@ -33,9 +33,18 @@ extern "C" {
  * an outline edge and its arc, relative to the radius (23 edges for a whole circle). */
 #define GP_MESH_DEFAULT_DISK_TOLERANCE 0.01
 /* A mesh may grow to this many times the element cap its spec was checked against
- * before the stage gives up: the estimate (gp_mesh_expected_elements) is good to about a
- * factor of two either way. */
+ * before the stage gives up: the estimate (gp_mesh_expected_elements) was 0.69 to 1.62
+ * times the count made on the reference cases (bench/MESH.md). */
 #define GP_MESH_CAP_SLACK 2
+/* Periodic domains: an outline vertex closer than this times the mean packing radius to
+ * a periodic side's line is put on it before the outlines are cut into pieces. Why: a
+ * vertex a little off the line leaves a sliver of band (or grain) as thin as its
+ * distance to the line, opening at the small angle of the vertex's edges, which Delaunay
+ * refinement can only fill with a cascade of tiny elements (a vertex 2e-4 R from the
+ * line made 110,000 extra nodes on the periodic iron mesh); on the line, it is an input
+ * corner, which CGAL's clusters handle. The outline moves by less than the polygonised
+ * disks' own tolerance (GP_MESH_DEFAULT_DISK_TOLERANCE), and only at such vertices. */
+#define GP_MESH_SIDE_SNAP_RTOL 0.01
 /* The most layers a spec may ask across a band strip. */
 #define GP_MESH_MAX_BAND_LAYERS 64
 
@@ -108,7 +117,13 @@ typedef struct gp_mesh_stats {
     size_t band_strips;           /* strips meshed with quadrilaterals (band_layers) */
     double band_thickness_min, band_thickness_mean; /* of those strips */
     size_t refused_refinements;   /* bad triangles the refinement left: fixing them would
-                                     have split a strip's outline (band_layers only) */
+                                     have split a strip's outline or (periodic) a side
+                                     locked in the last round */
+    size_t periodic_pairs[2];     /* node pairs across the periodic sides along x and y
+                                     (gp_mesh_periodic_pairs), corners included; 0 along a
+                                     walled axis */
+    int rounds;                   /* refinements run until the strips' and periodic sides
+                                     matched (1: they matched at once) */
 } gp_mesh_stats;
 
 /* A mesh. Node coordinates and connectivities as in Gmsh and VTK: corner nodes counter-
@@ -165,10 +180,12 @@ GP_API void gp_mesh_params_default(const gp_distribution *dist, gp_mesh_params *
 /* The mean grain radius of a law. */
 GP_API double gp_mesh_mean_radius(const gp_distribution *dist);
 
-/* An estimate (within a factor of about two) of the elements a mesh with `params` will
- * have, for a structure of `expected_disks` grains of law `dist` with joint `joint` in
- * `domain`, with cells shrunk by `shrink` (`has_cells` 0: disks in a matrix). Used to
- * refuse specs over a cap before any work. */
+/* An estimate of the elements a mesh with `params` will have (0.69 to 1.62 times the
+ * count made on the reference cases, seeds and options of bench/MESH.md;
+ * tests/test_mesh_estimate.c holds it within 0.6 to 1.7), for a structure of
+ * `expected_disks` grains of law `dist` with joint `joint` in `domain`, with cells shrunk
+ * by `shrink` (`has_cells` 0: disks in a matrix). Used to refuse specs over a cap before
+ * any work. */
 GP_API double gp_mesh_expected_elements(const gp_domain *domain, const gp_distribution *dist,
                                         const gp_joint *joint, double expected_disks, int has_cells,
                                         gp_shrink shrink, const gp_mesh_params *params);
@@ -195,6 +212,15 @@ GP_API int gp_mesh_build(const gp_mesh_input *input, const gp_mesh_params *param
                          const gp_progress *progress, gp_mesh *out, gp_error *err);
 
 GP_API void gp_mesh_free(gp_mesh *mesh);
+
+/* The node pairs of a mesh of a domain periodic along `axis` (0: x, 1: y): the nodes on
+ * the low side (x = 0, or y = 0) and their translates on the high side (x = W, y = H),
+ * the same coordinate along the side bit for bit, sorted along it, corners included:
+ * *pairs gets 2 * *n node indices (low, high), owned by the caller. With the axis not
+ * periodic: 0 and no pairs. Returns 0, GP_ENOMEM, or GP_EGEOM when the sides' nodes do
+ * not pair up one to one (not a periodic mesh). */
+GP_API int gp_mesh_periodic_pairs(const gp_mesh *mesh, const gp_domain *domain, int axis,
+                                  int32_t **pairs, size_t *n);
 
 #ifdef __cplusplus
 }

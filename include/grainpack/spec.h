@@ -87,6 +87,10 @@ typedef struct gp_spec {
 GP_API int gp_spec_parse(const char *text, size_t len, const gp_spec_limits *limits, gp_spec *spec,
                          gp_error *err);
 
+/* Reads the whole file at `path` into a new buffer (the caller frees *text with free()):
+ * 0, GP_EIO (with the system's reason) or GP_ENOMEM, with err set. */
+GP_API int gp_spec_read_text(const char *path, char **text, size_t *len, gp_error *err);
+
 /* Reads and parses a spec file (as gp_spec_parse; GP_EIO if it cannot be read). */
 GP_API int gp_spec_load_file(const char *path, const gp_spec_limits *limits, gp_spec *spec,
                              gp_error *err);

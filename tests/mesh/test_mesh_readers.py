@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """test_mesh_readers.py - every mesh format read back by the field's own tools, and the
-counts and groups they find equal to what grainpack's statistics report:
+counts and groups they find equal to what grainpack's statistics report (periodic meshes:
+the $Periodic section read by Gmsh and meshio, the Abaqus side sets paired in order):
 Gmsh itself (python3-gmsh: opens the .msh, lists its physical groups, counts its
 elements, and runs its own quality check, whose inverse condition numbers must be
 those of the statistics), meshio (python3-meshio: .msh, .inp and .vtu) and VTK's XML
@@ -131,6 +132,74 @@ def meshio_check(tmp, name, st, order, plane_strain=False):
             check(abs(quality.mean() - st["quality"]["mean"]) < 1e-9, f"{name}.vtu: quality mean differs")
 
 
+def periodic_check(tmp, name, s, st):
+    """A periodic mesh: Gmsh reads the $Periodic section (right a copy of left, top of
+    bottom, by the translation of one period) and its node pairs are every node of the
+    sides, translates of each other; the Abaqus node sets of opposite sides pair up in
+    order (k-th with k-th), meshio reading the same members."""
+    W, H = s["domain"]["width"], s["domain"]["height"]
+    per = s["domain"]["periodic"]
+    axes = ["x", "y"] if per is True else per
+    check(st["periodic"]["axes"] == axes, f"{name}: statistics say periodic {st['periodic']['axes']}")
+    path = os.path.join(tmp, name + ".msh")
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.open(path)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        xy = dict(zip((int(t) for t in tags), coords.reshape(-1, 3)[:, :2]))
+        # curves: left 1, right 2, bottom 3, top 4
+        for axis, (copy, master, shift) in (("x", (2, 1, (W, 0))), ("y", (4, 3, (0, H)))):
+            if axis not in axes:
+                continue
+            tag_master, nodes, masters, affine = gmsh.model.mesh.getPeriodicNodes(1, copy)
+            check(tag_master == master, f"{name}: Gmsh says curve {copy} copies {tag_master}")
+            want = [1, 0, 0, shift[0], 0, 1, 0, shift[1], 0, 0, 1, 0, 0, 0, 0, 1]
+            check(list(affine) == want, f"{name}: Gmsh reads the affine map {list(affine)}")
+            k = 0 if axis == "x" else 1
+            period = W if axis == "x" else H
+            low = {t for t, p in xy.items() if p[k] == 0.0}
+            high = {t for t, p in xy.items() if p[k] == period}
+            check(len(nodes) == st["periodic"]["node_pairs"][axis] == len(low) == len(high),
+                  f"{name}: {len(nodes)} pairs along {axis} for {len(low)} and {len(high)} side nodes")
+            check(set(int(t) for t in nodes) == high and set(int(t) for t in masters) == low,
+                  f"{name}: Gmsh's pairs along {axis} are not the sides' nodes")
+            bad = [(a, b) for a, b in zip(nodes, masters) if xy[int(a)][1 - k] != xy[int(b)][1 - k]]
+            check(not bad, f"{name}: {len(bad)} pairs along {axis} are not translates, e.g. {bad[:2]}")
+    finally:
+        gmsh.finalize()
+    # meshio reads the same links
+    links = meshio.read(path).gmsh_periodic or []
+    check(sorted(tuple(int(t) for t in link[1]) for link in links) ==
+          sorted({"x": (2, 1), "y": (4, 3)}[a] for a in axes), f"{name}.msh: meshio reads the links {links}")
+    check(all(len(link[3]) == st["periodic"]["node_pairs"]["x" if link[1][0] == 2 else "y"] for link in links),
+          f"{name}.msh: meshio reads other node pairs")
+    # Abaqus: the sets in the file's order
+    sets, current = {}, None
+    with open(os.path.join(tmp, name + ".inp")) as f:
+        for line in f:
+            if line.startswith("*"):
+                current = None
+                if line.lower().startswith("*nset"):
+                    current = line.split("nset=")[1].split(",")[0].strip()
+                    sets[current] = []
+            elif current:
+                sets[current] += [int(v) for v in line.replace(",", " ").split()]
+    m = meshio.read(os.path.join(tmp, name + ".inp"))
+    for axis, (lo, hi) in (("x", ("left", "right")), ("y", ("bottom", "top"))):
+        if axis not in axes:
+            continue
+        k = 0 if axis == "x" else 1
+        a, b = m.points[np.array(sets[lo]) - 1], m.points[np.array(sets[hi]) - 1]
+        check(len(a) == len(b) == st["periodic"]["node_pairs"][axis], f"{name}.inp: {lo} {len(a)}, {hi} {len(b)}")
+        check(np.all(a[:, 1 - k] == b[:, 1 - k]) and np.all(a[:, k] == 0.0) and
+              np.all(b[:, k] == (W if axis == "x" else H)), f"{name}.inp: {lo} and {hi} do not pair in order")
+        check(np.all(np.diff(a[:, 1 - k]) > 0), f"{name}.inp: {lo} is not in order along the side")
+        for side in (lo, hi):
+            got = {int(i) + 1 for i in m.point_sets[side]}
+            check(got == set(sets[side]), f"{name}.inp: meshio reads other members of {side}")
+
+
 def vtk_read(path):
     reader = vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(path)
@@ -163,6 +232,13 @@ def main():
              "grain_boundary", True),
             ("cells", spec(laguerre={"shrink": "none"}, mesh={"order": 2}), 2, None, False),
             ("matrix", spec(mesh={}), 1, "matrix", False),
+            # periodic: a period of 12 largest packing radii at least
+            ("torus", spec(domain={"width": 100, "height": 100, "periodic": True},
+                           laguerre={"shrink": "offset"}, mesh={"element_size": 4}), 1, "grain_boundary", False),
+            ("strip", spec(domain={"width": 100, "height": 60, "periodic": ["x"]},
+                           laguerre={"shrink": "none"}, mesh={"element_size": 4, "order": 2}), 2, None, False),
+            ("torus_matrix", spec(domain={"width": 100, "height": 100, "periodic": True},
+                                  mesh={"element_size": 4}), 1, "matrix", False),
         ]
         for name, s, order, second, strain in cases:
             st = mesh_stats(tmp, name, s)
@@ -174,6 +250,8 @@ def main():
             gmsh_check(os.path.join(tmp, name + ".msh"), st, order, grains, second)
             meshio_check(tmp, name, st, order, strain)
             vtk_check(os.path.join(tmp, name + ".vtu"), st)
+            if "periodic" in s["domain"]:
+                periodic_check(tmp, name, s, st)
             if name == "layers":
                 check(st["elements"]["quadrilaterals"] > 0, "band_layers made no quadrilaterals")
                 again = grainpack(tmp, name + "_again", s, "msh")
@@ -217,6 +295,23 @@ def main():
         check(sum(len(t) for t in tags) == st["elements"]["total"], "Gmsh counts other elements in the example")
         check(len(gmsh.model.getPhysicalGroups(2)) > 900, "the example has too few grains")
         gmsh.finalize()
+
+        # the periodic RVE example (balanced, offset cells, meshed on the torus): what the
+        # current build makes, and Gmsh, meshio and the Abaqus sets read its periodicity
+        rve = json.load(open(os.path.join(EXAMPLES, "iron_periodic.json")))["inputs"]
+        for fmt in ("msh", "inp", "vtu"):
+            grainpack(tmp, "iron_periodic", rve, fmt)
+        check(open(os.path.join(tmp, "iron_periodic.msh"), "rb").read() ==
+              open(os.path.join(EXAMPLES, "iron_periodic.msh"), "rb").read(),
+              "examples/iron_periodic.msh is not what the build makes")
+        st = mesh_stats(tmp, "iron_periodic", rve)
+        check(st["periodic"]["node_pairs"]["x"] > 0 and st["periodic"]["node_pairs"]["y"] > 0,
+              f"the RVE has no node pairs: {st['periodic']}")
+        periodic_check(tmp, "iron_periodic", rve, st)
+        regions = np.concatenate(meshio.read(os.path.join(tmp, "iron_periodic.vtu")).cell_data["region"])
+        grains = sorted({int(r) for r in regions if r < regions.max()})
+        check(len(grains) > 900, f"the RVE meshes {len(grains)} grains")
+        gmsh_check(os.path.join(EXAMPLES, "iron_periodic.msh"), st, 1, grains, "grain_boundary")
 
     print(f"{checks[0] - len(failures)} passed, {len(failures)} failed")
     return 1 if failures else 0

@@ -9,6 +9,7 @@ job without one are 400; its vtu is the grains, which meshio reads). The downloa
 (msh, inp, vtu plain and gzip, svg, json, statistics) render the stored sections: the
 daemon's grainpack_pipeline_runs_total does not move. Responses are checked against
 openapi.yaml.
+A periodic spec with a mesh is accepted and its .msh carries the $Periodic section.
 Usage: test_service_mesh.py GRAINPACKD GRAINPACK"""
 
 import gzip
@@ -38,6 +39,39 @@ def mesh_spec(**mesh):
                        "laguerre": {"shrink": "offset"}, "mesh": mesh}}
 
 
+def periodic_spec(**mesh):
+    """A torus of a period of 12 largest packing radii at least (iron: 8.25)."""
+    spec = mesh_spec(**mesh)
+    spec["inputs"]["domain"] = {"width": 100, "height": 100, "periodic": True}
+    return spec
+
+
+def check_periodic(c, client, cli, tmp):
+    """A periodic spec with a mesh is accepted; its .msh download, the command line's
+    bytes, has the $Periodic section that meshio reads (test_mesh_readers has Gmsh's
+    reading of it)."""
+    spec = periodic_spec(element_size=4)
+    r = client.submit(spec)
+    c.check(r.status == 201, f"a periodic spec with a mesh: {r}")
+    info = client.wait_final(r.json()["jobID"])
+    if not c.check(info["status"] == "successful", f"the periodic mesh job: {info}"):
+        return
+    st = client.get(f"/jobs/{info['jobID']}/statistics").json()["mesh"]
+    c.check(st["periodic"]["axes"] == ["x", "y"] and st["periodic"]["node_pairs"]["x"] > 2,
+            f"periodic mesh statistics: {st['periodic']}")
+    r = client.get(f"/jobs/{info['jobID']}/results?f=msh")
+    path = os.path.join(tmp, "periodic.json")
+    with open(path, "w") as f:
+        json.dump(spec, f)
+    made = subprocess.run([cli, "run", path, "-f", "msh"], capture_output=True, check=True).stdout
+    c.check(r.status == 200 and r.body == made and b"$Periodic" in r.body,
+            f"periodic msh: {r.status}, {len(r.body)} bytes, the command line's {len(made)}")
+    links = read_mesh(tmp, "periodic.msh", r.body).gmsh_periodic or []
+    c.check(len(links) == 2 and [len(lk[3]) for lk in links] == [st["periodic"]["node_pairs"]["x"],
+                                                                 st["periodic"]["node_pairs"]["y"]],
+            f"meshio reads {len(links)} periodic links")
+
+
 def bad_specs():
     """(what, spec, problem type, pointer) of meshing options the service must refuse."""
     no_cells = mesh_spec(band_layers=2)
@@ -47,6 +81,7 @@ def bad_specs():
     not_object = mesh_spec()
     not_object["inputs"]["mesh"] = 3
     no_band_size = mesh_spec(band_size=0.5)
+    periodic_layers = periodic_spec(band_layers=2)
     no_band_size["inputs"]["laguerre"] = {"shrink": "none"}
     invalid = "urn:grainpack:problem:invalid-spec"
     return [
@@ -63,6 +98,7 @@ def bad_specs():
         ("unknown option", mesh_spec(size=1), invalid, "/inputs/mesh/size"),
         ("unknown plane", mesh_spec(abaqus={"plane": "axisymmetric"}), invalid, "/inputs/mesh/abaqus/plane"),
         ("not an object", not_object, invalid, "/inputs/mesh"),
+        ("layers on a periodic domain", periodic_layers, invalid, "/inputs/mesh/band_layers"),
         ("beyond --max-elements", mesh_spec(element_size=0.05), "urn:grainpack:problem:job-too-big",
          "/inputs/mesh/element_size"),
     ]
@@ -193,6 +229,7 @@ def test(c, binary, cli):
             check_validation(c, api, client)
             check_downloads(c, api, client, cli, tmp)
             check_without_mesh(c, api, client, tmp)
+            check_periodic(c, client, cli, tmp)
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:
         daemon.cleanup()

@@ -1,0 +1,147 @@
+/* pack3d_bench.c - the 3D packer's figures (bench/PACK3D.md): density and time of the
+ * three reference laws in boxes of 20 largest diameters under both orders of the front,
+ * and the rate and memory at 10^5 and 10^6 spheres of one radius.
+ * Usage: grainpack_pack3d_bench [--seeds N] [--max-spheres N] [EXAMPLES_DIR] */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench_util.h"
+#include "grainpack/pack3d.h"
+#include "grainpack/spec.h"
+#include "machine.h"
+
+/* The peak resident set of the process (VmHWM) in bytes; with reset, first brings the
+ * peak down to the current resident set (Linux's clear_refs "5"). */
+static double peak_rss(int reset)
+{
+    if (reset) {
+        FILE *f = fopen("/proc/self/clear_refs", "w");
+        if (f) {
+            fputs("5", f);
+            fclose(f);
+        }
+    }
+    double kb = 0.0;
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "VmHWM:", 6) == 0)
+            kb = atof(line + 6);
+    if (f)
+        fclose(f);
+    return kb * 1024.0;
+}
+
+static double pack_once(const gp_box *box, const gp_distribution *dist, uint64_t seed,
+                        gp_pack3d_order order, gp_packing3d *out, double *cpu)
+{
+    gp_pack3d_params params = {box, dist, NULL, seed, 0, order};
+    gp_error err;
+    double c0 = bench_seconds(CLOCK_PROCESS_CPUTIME_ID), t0 = bench_now();
+    if (gp_pack3d(&params, NULL, out, &err))
+        bench_die("gp_pack3d", &err);
+    double t = bench_now() - t0;
+    *cpu = bench_seconds(CLOCK_PROCESS_CPUTIME_ID) - c0;
+    return t;
+}
+
+/* The law's row: mean and spread of the density over the seeds, spheres, times. */
+static void law_row(const char *name, const gp_distribution *dist, double side, int seeds)
+{
+    static const char *const orders[2] = {"level (walls first)", "lowest first"};
+    gp_box box = {side, side, side};
+    for (int o = 0; o < 2; o++) {
+        double sum = 0, sum2 = 0, cpu_sum = 0, wall_sum = 0, lo = 1, hi = 0;
+        size_t n = 0;
+        for (int s = 1; s <= seeds; s++) {
+            gp_packing3d out;
+            double cpu, wall = pack_once(&box, dist, (uint64_t)s, (gp_pack3d_order)o, &out, &cpu);
+            double d = out.fill_volume / (side * side * side);
+            sum += d;
+            sum2 += d * d;
+            lo = fmin(lo, d);
+            hi = fmax(hi, d);
+            cpu_sum += cpu;
+            wall_sum += wall;
+            n += out.count;
+            gp_packing3d_free(&out);
+        }
+        double mean = sum / seeds, sd = seeds > 1 ? sqrt(fmax(0, (sum2 - seeds * mean * mean) / (seeds - 1))) : 0;
+        printf("| %s | %s | %g | %.0f | %.4f +- %.4f (%.4f-%.4f) | %.1f ms | %.1f ms | %.0f |\n", name,
+               orders[o], side, (double)n / seeds, mean, sd, lo, hi, 1e3 * wall_sum / seeds,
+               1e3 * cpu_sum / seeds, (double)n / cpu_sum);
+        fflush(stdout);
+    }
+}
+
+/* Runs in a child process of its own, forked before any other packing (so that no freed
+ * heap of the parent's is reused unseen), with the peak resident set reset first. */
+static void scaling_row(const gp_distribution *dist, double target)
+{
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) {
+        perror("fork");
+        exit(1);
+    }
+    if (pid > 0) {
+        int status;
+        waitpid(pid, &status, 0);
+        return;
+    }
+    /* one radius 0.5: a box holding `target` spheres at a density of ~0.62 */
+    double side = cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.62);
+    gp_box box = {side, side, side};
+    double before = peak_rss(1);
+    gp_packing3d out;
+    double cpu, wall = pack_once(&box, dist, 1, GP_PACK3D_LEVEL, &out, &cpu);
+    double after = peak_rss(0);
+    printf("| %.0f | %.2f | %zu | %.4f | %.2f s | %.2f s | %.0f | %.0f | %.0f |\n", target, side, out.count,
+           out.fill_volume / (side * side * side), wall, cpu, out.count / wall, out.count / cpu,
+           (after - before) / (double)out.count);
+    fflush(stdout);
+    gp_packing3d_free(&out);
+    _exit(0);
+}
+
+int main(int argc, char **argv)
+{
+    int seeds = 5;
+    double max_spheres = 1e6;
+    const char *examples = "examples";
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--seeds") && i + 1 < argc)
+            seeds = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--max-spheres") && i + 1 < argc)
+            max_spheres = atof(argv[++i]);
+        else
+            examples = argv[i];
+    }
+    print_machine();
+    gp_distribution one = {.kind = GP_DIST_CONSTANT, .radius = 0.5};
+    gp_distribution bagi = {.kind = GP_DIST_UNIFORM, .min = 0.06, .max = 0.42};
+    char path[4096];
+    snprintf(path, sizeof path, "%s/iron.json", examples);
+    gp_spec iron;
+    gp_error err;
+    if (gp_spec_load_file(path, NULL, &iron, &err))
+        bench_die(path, &err);
+
+    printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS growth) |\n");
+    printf("|---|---|---|---|---|---|---|---|---|\n");
+    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
+        scaling_row(&one, n);
+    printf("\n| law | order | box side | spheres | density (mean +- sd, min-max over %d seeds) | wall | CPU | spheres per CPU s |\n",
+           seeds);
+    printf("|---|---|---|---|---|---|---|---|\n");
+    law_row("one radius 0.5", &one, 20.0, 2); /* the same packing for every seed */
+    law_row("uniform 0.06-0.42 (3D Bagi)", &bagi, 20 * 0.84, seeds);
+    law_row("iron histogram, 2-8 (no joint)", &iron.dist, 20 * 16.0, seeds);
+
+    gp_spec_free(&iron);
+    return 0;
+}

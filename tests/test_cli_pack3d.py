@@ -1,0 +1,95 @@
+"""test_cli_pack3d.py - `grainpack run` and `validate` on 3D specs (docs/3d.md): the process
+detected from the domain's "depth" or given by --process, the CSV read back by Python's csv
+module and checked on its own (no overlap beyond 1e-9, inside the box, the header), the
+same bytes from a file and from stdin, and the refusals with their exit statuses and JSON
+pointers. Usage: test_cli_pack3d.py PATH/TO/grainpack EXAMPLES_DIR"""
+import csv
+import io
+import json
+import math
+import subprocess
+import sys
+import tempfile
+import os
+
+BIN, EXAMPLES = sys.argv[1], sys.argv[2]
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+        print("FAIL:", what, file=sys.stderr)
+
+
+def run(args, stdin=None):
+    p = subprocess.run([BIN] + args, input=stdin, capture_output=True)
+    return p.returncode, p.stdout, p.stderr.decode()
+
+
+SPEC = {"inputs": {"domain": {"width": 6, "height": 5, "depth": 4},
+                   "distribution": {"kind": "uniform", "min": 0.2, "max": 0.5},
+                   "joint": {"law": "constant", "value": 0.05}, "seed": 3}}
+
+with tempfile.TemporaryDirectory() as tmp:
+    path = os.path.join(tmp, "box.json")
+    with open(path, "w") as f:
+        json.dump(SPEC, f)
+    out = os.path.join(tmp, "box.csv")
+    rc, _, err = run(["run", path, "-o", out])
+    check(rc == 0, "run exited %d: %s" % (rc, err))
+    with open(out, newline="") as f:
+        rows = list(csv.reader(f))
+    check(rows[0] == ["x", "y", "z", "r", "R"], "header %r" % rows[:1])
+    s = [tuple(float(v) for v in row) for row in rows[1:]]
+    check(len(s) > 100, "%d spheres" % len(s))
+    W, H, D = 6.0, 5.0, 4.0
+    for x, y, z, r, R in s:
+        check(0.2 <= r <= 0.5 and abs(R - (r + 0.05)) <= 1e-12, "radii %g %g" % (r, R))
+        for c, side in ((x, W), (y, H), (z, D)):
+            check(c - R >= -1e-9 * R and c + R <= side + 1e-9 * R, "outside: %r" % ((x, y, z, R),))
+    worst = -1.0
+    for i in range(len(s)):
+        for j in range(i):
+            d = math.dist(s[i][:3], s[j][:3])
+            worst = max(worst, 1.0 - d / (s[i][4] + s[j][4]))
+    check(worst <= 1e-9, "worst overlap %g" % worst)
+    # stdin gives the same bytes, --process pack3d changes nothing, validate agrees
+    with open(out, "rb") as f:
+        expected = f.read()
+    rc, got, _ = run(["run", "-"], stdin=json.dumps(SPEC).encode())
+    check(rc == 0 and got == expected, "stdin run differs")
+    rc, got, _ = run(["run", path, "--process", "pack3d", "-f", "csv"])
+    check(rc == 0 and got == expected, "--process pack3d differs")
+    rc, got, _ = run(["validate", path])
+    check(rc == 0 and b"pack3d" in got and b"spheres expected" in got, "validate: %r" % got)
+
+    # refusals: 3 for an invalid spec (with the field's pointer), 2 for a usage error
+    def refused(spec, status, pointer, args=()):
+        rc, _, err = run(["run", "-"] + list(args), stdin=json.dumps(spec).encode())
+        check(rc == status and pointer in err, "%r: exit %d, %s" % (spec, rc, err.strip()))
+
+    box = {"width": 6, "height": 5, "depth": 4}
+    law = {"kind": "constant", "radius": 0.3}
+    refused({"domain": dict(box, depth=0.5), "distribution": law}, 3, "/domain/depth")
+    refused({"domain": dict(box, depth=-1), "distribution": law}, 3, "/domain/depth")
+    refused({"domain": box, "distribution": {"kind": "uniform", "min": 0.01, "max": 0.3}}, 3,
+            "/distribution/min")
+    refused({"domain": dict(box, periodic=["x"]), "distribution": law}, 3, "/domain/periodic")
+    refused({"domain": box, "distribution": law, "balance": {}}, 3, "/balance")
+    refused({"inputs": {"domain": dict(box, depth="deep"), "distribution": law}}, 3,
+            "/inputs/domain/depth")
+    refused({"domain": box, "distribution": law}, 2, "csv only", ["-f", "json"])
+    # a 2D spec asked for as pack3d: the depth is missing; a 3D one as pack2d: depth unknown
+    rc, _, err = run(["run", os.path.join(EXAMPLES, "iron.json"), "--process", "pack3d"])
+    check(rc == 3 and "/inputs/domain/depth" in err, "2D spec as pack3d: %d %s" % (rc, err))
+    rc, _, err = run(["run", path, "--process", "pack2d"])
+    check(rc == 3 and "/inputs/domain/depth" in err, "3D spec as pack2d: %d %s" % (rc, err))
+    rc, _, err = run(["run", path, "--process", "pack4d"])
+    check(rc == 2, "unknown process: %d" % rc)
+    # the cap on spheres
+    rc, _, err = run(["run", path, "--max-disks", "50"])
+    check(rc == 3 and "/inputs/domain" in err, "cap: %d %s" % (rc, err))
+
+print("%d failure(s)" % len(failures), file=sys.stderr)
+sys.exit(1 if failures else 0)
