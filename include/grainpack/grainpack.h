@@ -59,6 +59,7 @@
 #include "grainpack/out.h"
 #include "grainpack/pack.h"
 #include "grainpack/pack3d.h"
+#include "grainpack/geometry3d.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/progress.h"
 #include "grainpack/rng.h"
