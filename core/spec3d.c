@@ -102,13 +102,16 @@ static int parse_root(validator *v, const json_t *root, void *out)
         if (!json_is_object(inputs))
             return gp_error_set(v->err, GP_EINVAL, "/inputs", "must be an object");
     }
-    static const char *const members[] = {"domain", "distribution", "joint", "seed", NULL};
+    static const char *const members[] = {"domain", "distribution", "joint", "seed", "balance", "laguerre", NULL};
     if ((rc = spec_check_members(v, inputs, base, members,
-                                 "domain, distribution, joint, seed (the 3D process takes no more yet)")) ||
+                                 "domain, distribution, joint, seed, balance, laguerre")) ||
         (rc = parse_box(v, inputs, base, &spec->box)) ||
         (rc = spec_parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = spec_parse_joint(v, inputs, base, &spec->joint)) ||
-        (rc = spec_parse_seed(v, inputs, base, &spec->seed)) || (rc = check_whole(v, base, spec)))
+        (rc = spec_parse_seed(v, inputs, base, &spec->seed)) ||
+        (rc = spec_parse_balance(v, inputs, base, &spec->balance_enabled, &spec->balance)) ||
+        (rc = spec_parse_laguerre(v, inputs, base, &spec->laguerre_enabled, &spec->laguerre)) ||
+        (rc = check_whole(v, base, spec)))
         return rc;
     if (gp_distribution_prepare(&spec->dist))
         return gp_error_set(v->err, GP_ENOMEM, "", "out of memory");
