@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "balance_watch.h"
 #include "nearby.h"
 #include "periodic.h"
 #include "quality.h"
@@ -234,17 +235,6 @@ static void move_ghosts(balancer *b, int32_t i)
     }
 }
 
-static int report(const gp_progress *progress, double fraction, gp_error *err)
-{
-    if (!progress)
-        return 0;
-    if (gp_canceled(progress->cancel))
-        return gp_error_set(err, GP_ECANCELED, NULL, "balancing canceled");
-    if (progress->report)
-        progress->report(progress->ctx, "balance", fraction);
-    return 0;
-}
-
 /* Steps centre `id` (interior, with the given ring) unless its last step still holds
  * (settled.h): 1 if it moved, 0 if not, or GP_ENOMEM. */
 static int visit(balancer *b, int32_t id, const int32_t *ring, size_t degree, uint64_t *refused)
@@ -309,7 +299,7 @@ static int sweep(balancer *b, const gp_progress *progress, double done, double s
         settled_sweep(&b->settled);
     for (size_t i = 0; i < b->n; i++) {
         if (i % CENTRES_PER_REPORT == CENTRES_PER_REPORT - 1) {
-            int rc = report(progress, done + share * (double)i / (double)b->n, err);
+            int rc = balance_report(progress, done + share * (double)i / (double)b->n, err);
             if (rc)
                 return rc;
         }
@@ -400,28 +390,6 @@ static int follow_moves(balancer *b, gp_rt_update update, gp_rt_update_stats *co
     if ((rc = rings_refresh(&b->rings, b->rt, b->changed, cancel)))
         return rings_failed(rc, b->m, err);
     return measure(b, histogram, stats, cancel, err);
-}
-
-/* Whether structure `a` is better than `best`: a lower F_max (the report's figure),
- * else as low an F_max and a lower mean. Differences below GP_BALANCE_QUALITY_TOL do not
- * count, so that a structure that only wanders does not look like progress. */
-static int improves(const gp_quality_stats *a, const gp_quality_stats *best)
-{
-    if (a->max < best->max - GP_BALANCE_QUALITY_TOL)
-        return 1;
-    return a->max <= best->max && a->mean < best->mean - GP_BALANCE_QUALITY_TOL;
-}
-
-/* Whether a relocation is steady (GP_BALANCE_STEADY_MIN_INTERIOR): F_max not lowered for
- * GP_BALANCE_STEADY_SWEEPS sweeps, and `lowest_mean`, the lowest mean F seen, less than
- * GP_BALANCE_STEADY_RTOL below `lowest_before`, the lowest seen GP_BALANCE_STEADY_SWEEPS
- * sweeps ago. */
-static int steady(const balancer *b, size_t interior, uint32_t since_lowered_max, double lowest_before,
-                  double lowest_mean)
-{
-    return b->method == GP_BALANCE_RELOCATION && interior >= GP_BALANCE_STEADY_MIN_INTERIOR &&
-           since_lowered_max >= GP_BALANCE_STEADY_SWEEPS &&
-           lowest_before - lowest_mean < GP_BALANCE_STEADY_RTOL * lowest_mean;
 }
 
 static void save_best(balancer *b)
@@ -563,18 +531,12 @@ static int run_sweeps(balancer *b, const gp_balance_params *params, const gp_pro
                                  : start_sweeps(b, 1, progress, &out->before, err);
     if (rc)
         return rc;
-    /* `best` is the structure returned; the lowest F_max and the lowest mean seen, even
-     * in two different structures, tell whether the sweeps still make progress */
-    gp_quality_stats best = out->before, now;
-    double lowest_max = best.max, lowest_mean = best.mean;
-    /* the lowest mean after each of the last sweeps (round robin), and when F_max was
-     * last lowered */
-    double lowest_means[GP_BALANCE_STEADY_SWEEPS];
-    lowest_means[0] = lowest_mean;
-    uint32_t lowered_max = 0;
+    balance_watch watch;
+    balance_watch_start(&watch, &out->before);
+    gp_quality_stats now;
     save_best(b);
     out->stop = GP_BALANCE_STOP_CAP;
-    for (uint32_t stall = 0; out->sweeps < cap;) {
+    while (out->sweeps < cap) {
         double share = 1.0 / cap;
         if (b->domain->periodic && b->drift > LAYER_DRIFT_SHARE * b->layer.margin) {
             /* the same structure, wrapped: F as it was, to rounding */
@@ -591,31 +553,16 @@ static int run_sweeps(balancer *b, const gp_balance_params *params, const gp_pro
             break;
         }
         if ((rc = follow(b, params->update, &out->triangulation, 0, progress, &now, err)) ||
-            (rc = report(progress, share * out->sweeps, err)))
+            (rc = balance_report(progress, share * out->sweeps, err)))
             return rc;
         nearby_sort(&b->near, b->disks);
-        if (improves(&now, &best)) {
-            best = now;
+        int better, stop = balance_watch_sweep(&watch, b->method, out->sweeps, &now, &better);
+        if (better) {
             out->best_sweep = out->sweeps;
             save_best(b);
         }
-        int lower_max = now.max < lowest_max - GP_BALANCE_QUALITY_TOL;
-        int lower_mean = now.mean < lowest_mean - GP_BALANCE_QUALITY_TOL;
-        lowered_max = lower_max ? out->sweeps : lowered_max;
-        lowest_max = now.max < lowest_max ? now.max : lowest_max;
-        lowest_mean = now.mean < lowest_mean ? now.mean : lowest_mean;
-        /* the slot of the sweep GP_BALANCE_STEADY_SWEEPS ago, overwritten below */
-        double *slot = &lowest_means[out->sweeps % GP_BALANCE_STEADY_SWEEPS];
-        if (out->sweeps >= GP_BALANCE_STEADY_SWEEPS &&
-            steady(b, now.interior, out->sweeps - lowered_max, *slot, lowest_mean)) {
-            out->stop = GP_BALANCE_STOP_STEADY;
-            break;
-        }
-        *slot = lowest_mean;
-        if (lower_max || lower_mean)
-            stall = 0;
-        else if (++stall >= GP_BALANCE_STALL_SWEEPS) {
-            out->stop = GP_BALANCE_STOP_STALLED;
+        if (stop >= 0) {
+            out->stop = (gp_balance_stop)stop;
             break;
         }
     }
