@@ -1,4 +1,4 @@
-/* balance3d.c - F and the balancing of a sphere packing (geometry3d.h, docs/3d.md §9): the
+/* balance3d.c - F and the balancing of a sphere packing (geometry3d.h, docs/3d.md §8): the
  * 2D methods of balance.c in 3D, each interior centre moved a step toward its target (the
  * barycentre of its neighbours, or of the positions tangent to the three spheres of each
  * face of its star), refused when the step would overlap a sphere or leave the box; the
@@ -143,7 +143,7 @@ static void grid_remove(balancer3 *b, int32_t id)
     *link = b->grid.next[id];
 }
 
-/* The relocation target (docs/3d.md §9): the barycentre of the conflict-free positions
+/* The relocation target (docs/3d.md §8): the barycentre of the conflict-free positions
  * tangent to the three spheres of each face of the star of i (the face of each tetrahedron
  * around i opposite i), each on i's side of the face, where the gaps to those three are
  * zero. The 2D rule with an edge of the ball's boundary replaced by a triangle. */

@@ -1,5 +1,5 @@
 /* laguerre3d.c - the Laguerre (power) polyhedra of a sphere packing clipped to the box and
- * shrunk (geometry3d.h, docs/3d.md §8): each cell is the box cut by the radical planes of
+ * shrunk (geometry3d.h, docs/3d.md §7): each cell is the box cut by the radical planes of
  * the centre's neighbours in the regular triangulation, in coordinates relative to the
  * centre (polyhedron.c), as laguerre.c does with polygons in 2D. */
 #include <math.h>
@@ -27,9 +27,20 @@ typedef struct builder {
     size_t *nstart;      /* the unshrunk cells' grain neighbours, for the symmetry */
     int32_t *nb;
     size_t nnb, nb_cap;
+    double power_carry;  /* the rounding left out of out->power_volume_sum (Neumaier) */
 } builder;
 
-/* Shrinks the cell in bd->pc.a (docs/3d.md §8): homothetic about the centre, or offset: the
+/* Adds v to *sum with Neumaier's compensation in *carry: a plain sum of 10^5 cell volumes
+ * drifts by 1e-12 of the total (measured: 7e-14 at 25 000 cells, 1.2e-12 at 84 000), the
+ * tiling test's tolerance; compensated, the error stays at a few ulps of the total. */
+static void add_compensated(double *sum, double *carry, double v)
+{
+    double t = *sum + v;
+    *carry += fabs(*sum) >= fabs(v) ? (*sum - t) + v : (v - t) + *sum;
+    *sum = t;
+}
+
+/* Shrinks the cell in bd->pc.a (docs/3d.md §7): homothetic about the centre, or offset: the
  * box cut again by every face's half-space moved inward by j = R - r (walls by j too
  * unless flush_boundary; the erosion of a convex polyhedron by a ball is the intersection
  * of its faces' half-spaces moved in). */
@@ -138,7 +149,7 @@ static int build_cell(builder *bd, int32_t i, gp_error *err)
     size_t degree = bd->ring_start[i + 1] - bd->ring_start[i];
     int holds_centre, rc = power_cell3d_build(&bd->pc, i, ring, degree, &holds_centre);
     if (rc == 0 && holds_centre && bd->pc.a.nf >= 4) {
-        bd->out->power_volume_sum += poly_volume(&bd->pc.a);
+        add_compensated(&bd->out->power_volume_sum, &bd->power_carry, poly_volume(&bd->pc.a));
         if ((rc = record_neighbours(bd, i)) == 0 && (rc = shrink(bd)) == 0)
             rc = emit(bd, i);
     }
@@ -241,6 +252,7 @@ int gp_laguerre3d(const gp_box *box, const gp_sphere *spheres, size_t n, const g
             rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the cells");
     }
     if (rc == 0) {
+        out->power_volume_sum += bd.power_carry;
         symmetrize(&bd);
         if (progress && progress->report)
             progress->report(progress->ctx, "laguerre", 1.0);
