@@ -18,7 +18,7 @@
 extern "C" {
 #endif
 
-/* The plane of the section picture (docs/3d.md §7): normal to `axis` (0 x, 1 y, 2 z), at
+/* The plane of the section picture (docs/3d.md §8): normal to `axis` (0 x, 1 y, 2 z), at
  * the fraction `at` in [0, 1] of the box along it. */
 typedef struct gp_section3d {
     int axis;
