@@ -189,6 +189,12 @@ static int run3d(const spec_text *st, gp_format3d format, const char *out_path, 
     int status = load_spec3d(st, max_disks, &spec);
     if (status)
         return status;
+    if (format == GP_FORMAT3D_TESS && !spec.laguerre_enabled) { /* refused before the work */
+        fprintf(stderr, "grainpack: %s: --format tess is the Laguerre tessellation: add \"laguerre\": {} "
+                        "to the spec\n", st->path);
+        gp_spec3d_free(&spec);
+        return EXIT_USAGE;
+    }
     terminal_progress tp = {-1};
     gp_progress progress = {show_progress, &tp, NULL};
     int tty = isatty(STDERR_FILENO);
@@ -211,8 +217,15 @@ static int run3d(const spec_text *st, gp_format3d format, const char *out_path, 
         return EXIT_USAGE;
     }
     if (tty)
+    {
         fprintf(stderr, "grainpack: %zu spheres, packing density %.4f, %.1f ms\n", result.stats.count,
                 result.stats.packing_density, 1e3 * gp_result3d_stage_seconds(&result, "pack"));
+        if (result.has_cells)
+            fprintf(stderr, "grainpack: %zu polyhedra (%s), %.2f faces each, boundary phase %.4f of the "
+                            "box, %.1f ms\n",
+                    result.cell_stats.count, gp_shrink_name(result.cells.shrink), result.cell_stats.faces_mean,
+                    result.cell_stats.boundary_fraction, 1e3 * gp_result3d_stage_seconds(&result, "laguerre"));
+    }
     result3d_output what = {format, &spec, &result, &err};
     status = write_output(out_path, write_result3d, &what);
     if (status && err.code)

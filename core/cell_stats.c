@@ -6,6 +6,7 @@
 
 #include "grainpack/error.h"
 #include "grainpack/stats.h"
+#include "cell_tally.h"
 
 int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
                           const gp_disk *disks, const gp_cells *cells, gp_cell_stats *out)
@@ -24,42 +25,29 @@ int gp_cell_stats_compute(const gp_domain *domain, const gp_distribution *dist,
         gp_cell_stats_free(out);
         return GP_ENOMEM;
     }
-    double area_sum = 0.0, req_sum = 0.0, ratio_sum = 0.0, neighbour_sum = 0.0;
+    cell_tally t = {.bins = out->req_bins, .nbins = out->nbins};
+    double neighbour_sum = 0.0;
     for (size_t i = 0; i < n; i++) {
-        double a = cells->area[i], req = sqrt(a / M_PI);
+        double a = cells->area[i];
         size_t k = cells->nstart[i + 1] - cells->nstart[i];
         out->neighbour_histogram[k]++;
         neighbour_sum += (double)k;
-        area_sum += a;
-        req_sum += req;
-        ratio_sum += req / disks[i].r;
-        if (i == 0 || a < out->area_min)
-            out->area_min = a;
-        if (i == 0 || a > out->area_max)
-            out->area_max = a;
-        if (i == 0 || req < out->req_min)
-            out->req_min = req;
-        if (i == 0 || req > out->req_max)
-            out->req_max = req;
-        long b = gp_bin_table_find(out->req_bins, out->nbins, req);
-        if (b >= 0)
-            out->req_bins[b].count++;
-        else
-            out->req_outside++;
+        cell_tally_add(&t, i, a, sqrt(a / M_PI), disks[i].r);
     }
-    double span = out->area_max - out->area_min;
-    for (size_t i = 0; i < n; i++) {
-        int bin = span > 0.0 ? (int)((cells->area[i] - out->area_min) / span * GP_CELL_AREA_BINS) : 0;
-        out->area_histogram[bin < GP_CELL_AREA_BINS ? bin : GP_CELL_AREA_BINS - 1]++;
-    }
+    out->area_min = t.size_min;
+    out->area_max = t.size_max;
+    out->req_min = t.req_min;
+    out->req_max = t.req_max;
+    out->req_outside = t.outside;
+    cell_tally_histogram(cells->area, n, out->area_min, out->area_max, out->area_histogram, GP_CELL_AREA_BINS);
     double A = gp_domain_area(domain);
     if (n) {
-        out->area_mean = area_sum / (double)n;
-        out->req_mean = req_sum / (double)n;
-        out->req_ratio_mean = ratio_sum / (double)n;
+        out->area_mean = t.size_sum / (double)n;
+        out->req_mean = t.req_sum / (double)n;
+        out->req_ratio_mean = t.ratio_sum / (double)n;
         out->neighbours_mean = neighbour_sum / (double)n;
     }
-    out->band_fraction = 1.0 - area_sum / A;
+    out->band_fraction = 1.0 - t.size_sum / A;
     out->tiling_error = (cells->power_area_sum - A) / A;
     gp_bin_table_finish(out->req_bins, out->nbins, n, &out->req_max_abs_z);
     return 0;

@@ -1,6 +1,5 @@
 /* io_format3d.c - the 3D formats by name, what each needs of a result, and the one entry
  * that writes a result in any of them. */
-#include <stdlib.h>
 #include <string.h>
 
 #include "grainpack/io3d.h"
@@ -48,20 +47,8 @@ int gp_format3d_check(gp_format3d format, const gp_result3d *result, gp_error *e
     if (format == GP_FORMAT3D_TESS && !result->has_cells)
         return gp_error_set(err, GP_EINVAL, NULL,
                             "tess is the Laguerre tessellation: the spec must ask for cells "
-                            "(\"cells\": {...})");
+                            "(\"laguerre\": {...})");
     return 0;
-}
-
-/* Frees what gp_result3d_power_cells made (every array of a gp_cells3d is owned). */
-static void free_power(gp_cells3d *c)
-{
-    free(c->vstart);
-    free(c->xyz);
-    free(c->fstart);
-    free(c->fvstart);
-    free(c->fverts);
-    free(c->fneighbour);
-    free(c->volume);
 }
 
 static int write_tess(gp_out *out, const gp_spec3d *spec, const gp_result3d *result, gp_error *err)
@@ -73,7 +60,7 @@ static int write_tess(gp_out *out, const gp_spec3d *spec, const gp_result3d *res
     if (rc)
         return rc;
     rc = gp_write_tess(out, &spec->box, result->packing.spheres, &power, err);
-    free_power(&power);
+    gp_cells3d_free(&power);
     return rc;
 }
 

@@ -62,18 +62,53 @@ void gp_pack3d_stats_free(gp_pack3d_stats *stats)
     memset(stats, 0, sizeof *stats);
 }
 
+/* The Laguerre stage: the polyhedra of the spheres as `params` shrinks them, on a
+ * triangulation built here (`since`: when its build started, for the stage times). */
+static int polyhedra(const gp_spec3d *spec, const gp_packing3d *packing, const gp_laguerre_params *params,
+                     const gp_progress *progress, gp_cells3d *out, gp_result3d *timed, gp_error *err)
+{
+    gp_rt3 *rt = NULL;
+    double t = now_seconds();
+    int rc = gp_rt3_build(packing->spheres, packing->count, progress, &rt, err);
+    if (rc)
+        return rc;
+    if (timed)
+        record(timed, "triangulation", t);
+    t = now_seconds();
+    rc = gp_laguerre3d(&spec->box, packing->spheres, packing->count, rt, params, progress, out, err);
+    gp_rt3_free(rt);
+    if (!rc && timed)
+        record(timed, "laguerre", t);
+    return rc;
+}
+
 int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progress *progress,
                       gp_result3d *result, gp_error *err)
 {
     memset(result, 0, sizeof *result);
+    if (spec->balance_enabled) /* gp_balance3d is declared (geometry3d.h) but not built yet */
+        return gp_error_set(err, GP_EINVAL, "/balance", "3D balancing is not available in this build yet");
     gp_pack3d_params params = gp_spec3d_pack_params(spec, max_spheres);
     double t = now_seconds();
     int rc = gp_pack3d(&params, progress, &result->packing, err);
     if (rc)
         return rc;
     record(result, "pack", t);
+    if (spec->laguerre_enabled) {
+        if (gp_canceled(gp_progress_cancel(progress)))
+            rc = gp_error_set(err, GP_ECANCELED, NULL, "canceled before the laguerre stage");
+        else
+            rc = polyhedra(spec, &result->packing, &spec->laguerre, progress, &result->cells, result, err);
+        if (rc) {
+            gp_result3d_free(result);
+            return rc;
+        }
+        result->has_cells = 1;
+    }
     t = now_seconds();
-    if (gp_pack3d_stats_compute(&spec->box, &spec->dist, &result->packing, &result->stats)) {
+    if (gp_pack3d_stats_compute(&spec->box, &spec->dist, &result->packing, &result->stats) ||
+        (result->has_cells && gp_cell3d_stats_compute(&spec->box, &spec->dist, result->packing.spheres,
+                                                       &result->cells, &result->cell_stats))) {
         gp_result3d_free(result);
         return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the statistics");
     }
@@ -84,10 +119,8 @@ int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progre
 int gp_result3d_power_cells(const gp_spec3d *spec, const gp_result3d *result, gp_cells3d *out,
                             gp_error *err)
 {
-    (void)spec;
-    (void)result;
-    memset(out, 0, sizeof *out);
-    return gp_error_set(err, GP_EINVAL, NULL, "this build has no 3D Laguerre stage yet");
+    gp_laguerre_params none = {GP_SHRINK_NONE, 0};
+    return polyhedra(spec, &result->packing, &none, NULL, out, NULL, err);
 }
 
 void gp_result3d_free(gp_result3d *result)
@@ -96,6 +129,10 @@ void gp_result3d_free(gp_result3d *result)
     gp_pack3d_stats_free(&result->stats);
     if (result->has_balance)
         gp_balance_result_free(&result->balance);
+    if (result->has_cells) {
+        gp_cells3d_free(&result->cells);
+        gp_cell3d_stats_free(&result->cell_stats);
+    }
     memset(result, 0, sizeof *result);
 }
 

@@ -394,7 +394,8 @@ static int get_bool(validator *v, const json_t *obj, const char *base, const cha
     return 0;
 }
 
-static int parse_balance(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+int spec_parse_balance(validator *v, const json_t *inputs, const char *base, int *enabled,
+                       gp_balance_params *balance)
 {
     char ptr[GP_ERROR_POINTER_MAX], member[GP_ERROR_POINTER_MAX];
     const json_t *obj;
@@ -408,11 +409,11 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
     int method;
     if ((rc = get_choice(v, obj, ptr, "method", methods, "none, laplacian, relocation", &method)))
         return rc;
-    spec->balance_enabled = 1;
-    spec->balance.method = (gp_balance_method)method;
-    spec->balance.max_iterations = GP_BALANCE_DEFAULT_MAX_ITERATIONS;
-    spec->balance.max_step = GP_BALANCE_DEFAULT_MAX_STEP;
-    spec->balance.update = GP_RT_UPDATE_FLIPS;
+    *enabled = 1;
+    balance->method = (gp_balance_method)method;
+    balance->max_iterations = GP_BALANCE_DEFAULT_MAX_ITERATIONS;
+    balance->max_step = GP_BALANCE_DEFAULT_MAX_STEP;
+    balance->update = GP_RT_UPDATE_FLIPS;
     const json_t *value = json_object_get(obj, "max_iterations");
     if (value) {
         spec_pointer_key(member, ptr, "max_iterations");
@@ -423,22 +424,23 @@ static int parse_balance(validator *v, const json_t *inputs, const char *base, g
         if (n < 1 || n > GP_SPEC_MAX_BALANCE_ITERATIONS)
             return gp_error_set(v->err, GP_EINVAL, member, "must be an integer from 1 to %d, got %lld",
                                 GP_SPEC_MAX_BALANCE_ITERATIONS, (long long)n);
-        spec->balance.max_iterations = (uint32_t)n;
+        balance->max_iterations = (uint32_t)n;
     }
     if (json_object_get(obj, "max_step")) {
         /* the steps tried go down by 0.05 to 0.05 (docs/method.md §4.4): a smaller first step tries none */
-        if ((rc = spec_get_number(v, obj, ptr, "max_step", 0.05, 1, &spec->balance.max_step)))
+        if ((rc = spec_get_number(v, obj, ptr, "max_step", 0.05, 1, &balance->max_step)))
             return rc;
-        if (spec->balance.max_step > 1.0) {
+        if (balance->max_step > 1.0) {
             spec_pointer_key(member, ptr, "max_step");
             return gp_error_set(v->err, GP_EINVAL, member, "must be <= 1 (the whole way to the target), got %.17g",
-                                spec->balance.max_step);
+                                balance->max_step);
         }
     }
     return 0;
 }
 
-static int parse_laguerre(validator *v, const json_t *inputs, const char *base, gp_spec *spec)
+int spec_parse_laguerre(validator *v, const json_t *inputs, const char *base, int *enabled,
+                        gp_laguerre_params *laguerre)
 {
     char ptr[GP_ERROR_POINTER_MAX];
     const json_t *obj;
@@ -452,9 +454,9 @@ static int parse_laguerre(validator *v, const json_t *inputs, const char *base, 
     int shrink;
     if ((rc = get_choice(v, obj, ptr, "shrink", shrinks, "homothetic, offset, none", &shrink)))
         return rc;
-    spec->laguerre_enabled = 1;
-    spec->laguerre.shrink = (gp_shrink)shrink;
-    return get_bool(v, obj, ptr, "flush_boundary", &spec->laguerre.flush_boundary);
+    *enabled = 1;
+    laguerre->shrink = (gp_shrink)shrink;
+    return get_bool(v, obj, ptr, "flush_boundary", &laguerre->flush_boundary);
 }
 
 /* Reads an optional number in [lower, upper] (lower excluded when `open_lower`). */
@@ -814,7 +816,8 @@ static int parse_root(validator *v, const json_t *root, gp_spec *spec)
         (rc = spec_parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = spec_parse_seed(v, inputs, base, &spec->seed)) ||
         (rc = parse_front(v, inputs, base, &spec->level_band, &spec->level_band_set)) ||
-        (rc = parse_balance(v, inputs, base, spec)) || (rc = parse_laguerre(v, inputs, base, spec)) ||
+        (rc = spec_parse_balance(v, inputs, base, &spec->balance_enabled, &spec->balance)) ||
+        (rc = spec_parse_laguerre(v, inputs, base, &spec->laguerre_enabled, &spec->laguerre)) ||
         (rc = parse_mesh(v, inputs, base, spec)) ||
         (rc = parse_picture(v, inputs, base, spec)) || (rc = check_whole(v, base, spec)))
         return rc;

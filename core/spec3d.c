@@ -137,13 +137,16 @@ static int parse_root(validator *v, const json_t *root, void *out)
         if (!json_is_object(inputs))
             return gp_error_set(v->err, GP_EINVAL, "/inputs", "must be an object");
     }
-    static const char *const members[] = {"domain", "distribution", "joint", "seed", "picture", NULL};
+    static const char *const members[] = {"domain", "distribution", "joint", "seed", "balance", "laguerre",
+                                          "picture", NULL};
     if ((rc = spec_check_members(v, inputs, base, members,
-                                 "domain, distribution, joint, seed, picture")) ||
+                                 "domain, distribution, joint, seed, balance, laguerre, picture")) ||
         (rc = parse_box(v, inputs, base, &spec->box)) ||
         (rc = spec_parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = spec_parse_joint(v, inputs, base, &spec->joint)) ||
         (rc = spec_parse_seed(v, inputs, base, &spec->seed)) ||
+        (rc = spec_parse_balance(v, inputs, base, &spec->balance_enabled, &spec->balance)) ||
+        (rc = spec_parse_laguerre(v, inputs, base, &spec->laguerre_enabled, &spec->laguerre)) ||
         (rc = parse_picture(v, inputs, base, &spec->section)) || (rc = check_whole(v, base, spec)))
         return rc;
     if (gp_distribution_prepare(&spec->dist))

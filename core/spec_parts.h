@@ -8,9 +8,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grainpack/balance.h"
 #include "grainpack/distribution.h"
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
+#include "grainpack/laguerre.h"
 #include "grainpack/spec.h"
 
 typedef struct validator {
@@ -34,6 +36,13 @@ int spec_get_number(validator *v, const json_t *obj, const char *base, const cha
 int spec_parse_distribution(validator *v, const json_t *inputs, const char *base, gp_distribution *d);
 int spec_parse_joint(validator *v, const json_t *inputs, const char *base, gp_joint *j);
 int spec_parse_seed(validator *v, const json_t *inputs, const char *base, uint64_t *seed);
+/* "balance" {"method", "max_iterations", "max_step"} and "laguerre" {"shrink",
+ * "flush_boundary"} (both optional): *enabled is set to 1 when the block is there, and the
+ * parameters filled with its fields and the defaults. */
+int spec_parse_balance(validator *v, const json_t *inputs, const char *base, int *enabled,
+                       gp_balance_params *balance);
+int spec_parse_laguerre(validator *v, const json_t *inputs, const char *base, int *enabled,
+                        gp_laguerre_params *laguerre);
 /* Parses the text as JSON (GP_EPARSE when it is not) and hands the root to `parse` with
  * a validator for `limits` (NULL: the defaults). Returns what `parse` returns; the
  * caller frees `spec` on failure. */

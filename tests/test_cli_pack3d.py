@@ -76,7 +76,9 @@ with tempfile.TemporaryDirectory() as tmp:
     refused({"domain": box, "distribution": {"kind": "uniform", "min": 0.01, "max": 0.3}}, 3,
             "/distribution/min")
     refused({"domain": dict(box, periodic=["x"]), "distribution": law}, 3, "/domain/periodic")
-    refused({"domain": box, "distribution": law, "balance": {}}, 3, "/balance")
+    rc, _, err = run(["run", "-"], stdin=json.dumps({"domain": box, "distribution": law, "balance": {}}).encode())
+    check(rc == 1 and "/balance" not in err and "balancing is not available" in err,
+          "3D balance before gp_balance3d: %d %s" % (rc, err))
     refused({"inputs": {"domain": dict(box, depth="deep"), "distribution": law}}, 3,
             "/inputs/domain/depth")
     refused({"domain": box, "distribution": law}, 2, "unknown format 'vtk' for pack3d", ["-f", "vtk"])

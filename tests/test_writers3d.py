@@ -85,6 +85,36 @@ def vtk_volumes(grid):
     return vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume"))
 
 
+def meshio_polyhedra(path):
+    """The polyhedra as meshio reads them: {grain: (faces as point lists, cell data)}.
+    meshio 5.0 (Debian 12) puts polyhedra in blocks by node count in the order it meets
+    them but their cell data in increasing node count, and its Mesh then refuses the
+    mismatch when the counts vary (as Laguerre cells' do); so its own reader is called
+    and blocks and data paired by node count."""
+    from meshio.vtu._vtu import VtuReader
+    r = VtuReader(path)
+    sizes = sorted(int(b.type[len("polyhedron"):]) for b in r.cells)
+    out = {}
+    for block in r.cells:
+        group = sizes.index(int(block.type[len("polyhedron"):]))
+        data = {name: values[group] for name, values in r.cell_data.items()}
+        for k, cell in enumerate(block.data):
+            faces = [[tuple(r.points[v]) for v in face] for face in cell]
+            out[int(data["grain"][k])] = (faces, {name: float(v[k]) for name, v in data.items()})
+    return out
+
+
+def faces_volume(faces):
+    """Divergence theorem over faces turning counter-clockwise seen from outside."""
+    vol = 0.0
+    for pts in faces:
+        for k in range(1, len(pts) - 1):
+            a, b, c = pts[0], pts[k], pts[k + 1]
+            vol += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                    a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0
+    return vol
+
+
 def svg_shapes(path):
     root = ET.parse(path).getroot()
     box = [float(v) for v in root.get("viewBox").split()]
@@ -239,12 +269,60 @@ with tempfile.TemporaryDirectory() as tmp:
         check(close(cx, s["y"]) and close(cy, s["z"]) and close(r, math.sqrt(s["r"] ** 2 - (s["x"] - 2.4) ** 2), 1e-9),
               "run.svg: circle of grain %d" % g)
 
+    # with polyhedra: the .tess checked alone and against the unshrunk cells' JSON volumes,
+    # VTK's volumes against the JSON's, each sphere's circle inside its cell's polygon
+    cells_spec = dict(spec, laguerre={"shrink": "offset"})
+    json.dump(cells_spec, open(path, "w"))
+    none_path = os.path.join(tmp, "none.json")
+    json.dump(dict(spec, laguerre={"shrink": "none"}), open(none_path, "w"))
+    for fmt in ("json", "vtu", "svg", "tess"):
+        dst = os.path.join(tmp, "cells." + fmt)
+        p = subprocess.run([BIN, "run", path, "-f", fmt, "-o", dst], capture_output=True, text=True)
+        check(p.returncode == 0, "cells run -f %s: %s" % (fmt, p.stderr))
+        out[fmt] = dst
+    p = subprocess.run([BIN, "run", none_path], capture_output=True, text=True)
+    power_doc = json.loads(p.stdout)
+    doc = json.load(open(out["json"]))
+    n = len(doc["spheres"])
+    check(doc["cells"]["count"] == n == len(doc["polyhedra"]) and doc["cells"]["shrink"] == "offset",
+          "cells.json: %r" % doc["cells"]["count"])
+    t = tess_reader.read(out["tess"])
+    bad = tess_reader.check(t, (6, 5, 4))
+    check(not bad, "cells.tess: %s" % bad[:5])
+    check(len(t.polys) == n and all(close(t.volumes[i + 1], power_doc["polyhedra"][i]["volume"], 1e-9)
+                                    for i in range(n)), "cells.tess: volumes against the unshrunk cells")
+    grid = vtk_read(out["vtu"])
+    vv = vtk_volumes(grid)
+    check(grid.GetNumberOfCells() == n and all(close(vv[i], doc["polyhedra"][i]["volume"], 1e-9) for i in range(n)),
+          "cells.vtu: VTK's volumes against the JSON's")
+    polys = meshio_polyhedra(out["vtu"])
+    check(sorted(polys) == list(range(n)), "cells.vtu: meshio reads %d polyhedra" % len(polys))
+    for g, (faces, data) in polys.items():
+        check(close(faces_volume(faces), doc["polyhedra"][g]["volume"], 1e-9) and
+              close(data["volume"], doc["polyhedra"][g]["volume"]) and close(data["r"], doc["spheres"][g]["r"]),
+              "cells.vtu: meshio's polyhedron %d: volume %g, want %g" % (g, faces_volume(faces),
+                                                                       doc["polyhedra"][g]["volume"]))
+    _, box, circles, polygons = svg_shapes(out["svg"])
+    check_circles("cells.svg", box, circles)
+    poly_of = {g: pts for pts, g in polygons}
+    check(len(polygons) >= len(circles) > 5, "cells.svg: %d polygons, %d circles" % (len(polygons), len(circles)))
+    for cx, cy, r, g in circles:  # offset shrink by j = R - r leaves the grain sphere inside its cell
+        pts = poly_of.get(g)
+        inside = pts is not None and polygon_area(pts) > 0
+        for k in range(len(pts or [])):
+            (ax, ay), (bx, by) = pts[k], pts[(k + 1) % len(pts)]
+            # counter-clockwise: the centre left of every edge, at least r from its line
+            dist = ((bx - ax) * (cy - ay) - (by - ay) * (cx - ax)) / math.hypot(bx - ax, by - ay)
+            inside = inside and dist >= r * (1 - 1e-9) - 1e-12
+        check(inside, "cells.svg: the circle of grain %d is not inside its polygon" % g)
+
     # refusals: a format the result cannot give, an unknown one, bad sections (with pointers)
     def refused(args, status, text, stdin=None):
         p = subprocess.run([BIN] + args, capture_output=True, text=True, input=stdin)
         check(p.returncode == status and text in p.stderr, "%r: exit %d, %s" % (args, p.returncode, p.stderr.strip()))
 
-    refused(["run", path, "-f", "tess"], 2, "the spec must ask for cells")
+    json.dump(spec, open(path, "w"))  # without "laguerre"
+    refused(["run", path, "-f", "tess"], 2, 'add "laguerre": {} to the spec')
     refused(["run", path, "-f", "msh"], 2, "unknown format 'msh' for pack3d")
     for section, pointer in (({"axis": "w"}, "/picture/section/axis"), ({"at": 1.5}, "/picture/section/at"),
                              ({"at": "half"}, "/picture/section/at"), ({"plane": 1}, "/picture/section/plane"),

@@ -97,18 +97,6 @@ static int make_cells(double scale, gp_cells3d *c)
     return 0;
 }
 
-static void free_cells(gp_cells3d *c)
-{
-    free(c->vstart);
-    free(c->xyz);
-    free(c->fstart);
-    free(c->fvstart);
-    free(c->fverts);
-    free(c->fneighbour);
-    free(c->volume);
-    memset(c, 0, sizeof *c);
-}
-
 static int write_file(const char *dir, const char *name, gp_format3d format, const gp_spec3d *spec,
                       const gp_result3d *result)
 {
@@ -166,13 +154,15 @@ int main(int argc, char **argv)
 
     result.has_cells = 1;
     failed |= make_cells(1.0, &result.cells);
-    result.cell_stats.count = CELLS;
+    failed |= gp_cell3d_stats_compute(&spec.box, &spec.dist, spheres, &result.cells, &result.cell_stats);
     failed |= write_file(dir, "power.tess", GP_FORMAT3D_TESS, &spec, &result);
     failed |= write_file(dir, "power.vtu", GP_FORMAT3D_VTU, &spec, &result);
     failed |= write_file(dir, "power.json", GP_FORMAT3D_JSON, &spec, &result);
-    free_cells(&result.cells);
+    gp_cells3d_free(&result.cells);
 
+    gp_cell3d_stats_free(&result.cell_stats);
     failed |= make_cells(GRAIN_RATIO, &result.cells);
+    failed |= gp_cell3d_stats_compute(&spec.box, &spec.dist, spheres, &result.cells, &result.cell_stats);
     double F[CELLS];
     for (int i = 0; i < CELLS; i++)
         F[i] = i % 2 ? 0.01 * i : NAN;
@@ -182,7 +172,7 @@ int main(int argc, char **argv)
     failed |= write_file(dir, "shrunk.vtu", GP_FORMAT3D_VTU, &spec, &result);
     failed |= write_file(dir, "shrunk.json", GP_FORMAT3D_JSON, &spec, &result);
     failed |= write_file(dir, "shrunk.svg", GP_FORMAT3D_SVG, &spec, &result);
-    free_cells(&result.cells);
+    gp_cells3d_free(&result.cells);
 
     char path[4096];
     snprintf(path, sizeof path, "%s/cuboids.json", dir);
@@ -192,6 +182,7 @@ int main(int argc, char **argv)
                    "\"ratio\": %.17g, \"tilt\": %.17g}\n", GRAIN_RATIO, TILT);
         fclose(f);
     }
+    gp_cell3d_stats_free(&result.cell_stats);
     gp_pack3d_stats_free(&result.stats);
     gp_spec3d_free(&spec);
     return failed || !f;

@@ -69,7 +69,9 @@ typedef struct gp_cells3d {
                              the face convex and planar */
     int32_t *fneighbour;  /* per face: the grain on the other side of the (unshrunk) power
                              face, or GP_WALL3D(k); a pair of grains shares at most one face
-                             and the relation is symmetric */
+                             and the relation is symmetric (offset cells: a small face the
+                             offset erodes away in one cell may stay in the other, whose
+                             joint is thinner; every face listed is a power face) */
     double *volume;       /* of each (shrunk) cell */
     double power_volume_sum; /* sum of the unshrunk power cells' volumes: the box's */
 } gp_cells3d;

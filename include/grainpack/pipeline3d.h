@@ -53,15 +53,17 @@ typedef struct gp_result3d {
     int ntimings;
 } gp_result3d;
 
-/* Runs every stage the spec asks for. `max_spheres` caps the packing (0: none). On
+/* Runs every stage the spec asks for ("laguerre": the triangulation and the polyhedra;
+ * "balance" is refused with GP_EINVAL at "/balance" until gp_balance3d is built). `max_spheres` caps the packing (0: none). On
  * success returns 0 and `result` owns everything in it (free with gp_result3d_free); on
  * failure returns the failing stage's code with err filled, and `result` is zeroed. */
 GP_API int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progress *progress,
                              gp_result3d *result, gp_error *err);
 
 /* The unshrunk power polyhedra of the result's spheres (what Neper's .tess describes):
- * built again from the spheres. Returns 0 and *out (free with gp_cells3d_free), or the
- * geometry's error with err filled; GP_EINVAL when this build has no 3D Laguerre stage. */
+ * built again from the spheres (a triangulation and the Laguerre stage without shrink).
+ * Returns 0 and *out (free with gp_cells3d_free), or the geometry's error with err
+ * filled. */
 GP_API int gp_result3d_power_cells(const gp_spec3d *spec, const gp_result3d *result, gp_cells3d *out,
                                    gp_error *err);
 

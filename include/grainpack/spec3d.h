@@ -35,6 +35,10 @@ typedef struct gp_spec3d {
     gp_joint joint;          /* GP_JOINT_NONE when the spec has none */
     uint64_t seed;
     double expected_spheres; /* a density of 0.64 over the mean packing-sphere volume */
+    int balance_enabled;     /* the spec has "balance" (the same block as 2D's) */
+    gp_balance_params balance;
+    int laguerre_enabled;    /* the spec has "laguerre": the polyhedra are asked for */
+    gp_laguerre_params laguerre; /* "laguerre": {"shrink", "flush_boundary"} */
     gp_section3d section;    /* "picture": {"section": {"axis", "at"}} */
 } gp_spec3d;
 
@@ -50,8 +54,10 @@ typedef enum gp_process {
 GP_API gp_process gp_spec_process(const char *text, size_t len);
 
 /* Parses and validates a 3D spec: {"inputs": {...}} or the bare inputs, with "domain"
- * {"width", "height", "depth"}, "distribution", "joint" (optional), "seed" (optional), "picture" (optional:
- * {"section": {"axis": "x" | "y" | "z", "at": a fraction in [0, 1]}}, default z at 0.5).
+ * {"width", "height", "depth"}, "distribution", "joint" (optional), "seed" (optional),
+ * "balance" and "laguerre" (optional; the fields, defaults and errors of 2D's), "picture"
+ * (optional: {"section": {"axis": "x" | "y" | "z", "at": a fraction in [0, 1]}}, default z
+ * at 0.5).
  * `limits` may be NULL; its max_disks caps the expected number of spheres. On success
  * returns 0 and `spec` owns its law (gp_spec3d_free). On failure returns GP_EPARSE,
  * GP_EINVAL or GP_ETOOBIG with err's pointer on the field, and leaves `spec` zeroed. */
