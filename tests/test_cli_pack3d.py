@@ -76,7 +76,7 @@ with tempfile.TemporaryDirectory() as tmp:
     refused({"domain": box, "distribution": {"kind": "uniform", "min": 0.01, "max": 0.3}}, 3,
             "/distribution/min")
     refused({"domain": dict(box, periodic=["x"]), "distribution": law}, 3, "/domain/periodic")
-    rc, _, err = run(["run", "-"], stdin=json.dumps({"domain": box, "distribution": law, "balance": {}}).encode())
+    rc, _, err = run(["run", "-"], stdin=json.dumps({"domain": box, "distribution": law, "balance": {"method": "relocation"}}).encode())
     check(rc == 1 and "/balance" not in err and "balancing is not available" in err,
           "3D balance before gp_balance3d: %d %s" % (rc, err))
     refused({"inputs": {"domain": dict(box, depth="deep"), "distribution": law}}, 3,
