@@ -97,19 +97,26 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
     out->r_mean = n ? sum_r / (double)n : 0.0;
 
     gp_bin_table_finish(out->bins, nbins, n, &out->max_abs_z);
+    gp_bin_table_chi2(out->bins, nbins, n, &out->chi2, &out->dof, &out->p_value);
+    return 0;
+}
+
+void gp_bin_table_chi2(const gp_bin_stat *bins, size_t nbins, size_t n, double *chi2, int *dof,
+                       double *p_value)
+{
     int used = 0;
+    *chi2 = 0.0;
     for (size_t i = 0; i < nbins; i++) {
-        const gp_bin_stat *b = &out->bins[i];
+        const gp_bin_stat *b = &bins[i];
         if (b->target > 0.0 && n) {
             double expected = b->target * (double)n;
             double diff = (double)b->count - expected;
-            out->chi2 += diff * diff / expected;
+            *chi2 += diff * diff / expected;
             used++;
         }
     }
-    out->dof = used > 0 ? used - 1 : 0;
-    out->p_value = out->dof > 0 ? gp_chi2_upper_tail(out->chi2, out->dof) : 1.0;
-    return 0;
+    *dof = used > 0 ? used - 1 : 0;
+    *p_value = *dof > 0 ? gp_chi2_upper_tail(*chi2, *dof) : 1.0;
 }
 
 void gp_pack_stats_free(gp_pack_stats *stats)

@@ -89,6 +89,11 @@ GP_API long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
 /* Fills `achieved`, `se` and `z` of every bin from its count out of n values, and *max_abs_z. */
 GP_API void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
 
+/* Pearson's chi-square of the counts of n values against the targets, over the bins with
+ * a target > 0, its degrees of freedom (those bins less one) and p-value (1 when dof is 0). */
+GP_API void gp_bin_table_chi2(const gp_bin_stat *bins, size_t nbins, size_t n, double *chi2, int *dof,
+                              double *p_value);
+
 /* The upper tail P(X >= x) of a chi-square law with dof degrees of freedom (dof >= 1). */
 GP_API double gp_chi2_upper_tail(double x, int dof);
 
