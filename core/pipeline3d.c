@@ -62,10 +62,12 @@ void gp_pack3d_stats_free(gp_pack3d_stats *stats)
     memset(stats, 0, sizeof *stats);
 }
 
-/* The Laguerre stage: the polyhedra of the spheres as `params` shrinks them, on a
- * triangulation built here (`since`: when its build started, for the stage times). */
-static int polyhedra(const gp_spec3d *spec, const gp_packing3d *packing, const gp_laguerre_params *params,
-                     const gp_progress *progress, gp_cells3d *out, gp_result3d *timed, gp_error *err)
+/* The stages on the triangulation: balancing (the spheres moved in place, `rt` kept up to
+ * date) then the polyhedra as `params` shrinks them. `timed` (NULL: no times) gets the
+ * stages' times; `balance` (NULL: no balancing) gets the balancing's result. */
+static int on_triangulation(const gp_spec3d *spec, gp_packing3d *packing, gp_balance_result *balance,
+                            const gp_laguerre_params *params, const gp_progress *progress,
+                            gp_cells3d *out, gp_result3d *timed, gp_error *err)
 {
     gp_rt3 *rt = NULL;
     double t = now_seconds();
@@ -74,11 +76,26 @@ static int polyhedra(const gp_spec3d *spec, const gp_packing3d *packing, const g
         return rc;
     if (timed)
         record(timed, "triangulation", t);
-    t = now_seconds();
-    rc = gp_laguerre3d(&spec->box, packing->spheres, packing->count, rt, params, progress, out, err);
+    if (balance) {
+        t = now_seconds();
+        rc = gp_balance3d(&spec->box, packing->spheres, packing->count, rt, &spec->balance, progress,
+                          balance, err);
+        if (rc) {
+            gp_rt3_free(rt);
+            return rc;
+        }
+        if (timed)
+            record(timed, "balance", t);
+    }
+    if (params) {
+        t = now_seconds();
+        rc = gp_laguerre3d(&spec->box, packing->spheres, packing->count, rt, params, progress, out, err);
+        if (!rc && timed)
+            record(timed, "laguerre", t);
+    }
     gp_rt3_free(rt);
-    if (!rc && timed)
-        record(timed, "laguerre", t);
+    if (rc && balance)
+        gp_balance_result_free(balance);
     return rc;
 }
 
@@ -86,24 +103,25 @@ int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progre
                       gp_result3d *result, gp_error *err)
 {
     memset(result, 0, sizeof *result);
-    if (spec->balance_enabled) /* gp_balance3d is declared (geometry3d.h) but not built yet */
-        return gp_error_set(err, GP_EINVAL, "/balance", "3D balancing is not available in this build yet");
     gp_pack3d_params params = gp_spec3d_pack_params(spec, max_spheres);
     double t = now_seconds();
     int rc = gp_pack3d(&params, progress, &result->packing, err);
     if (rc)
         return rc;
     record(result, "pack", t);
-    if (spec->laguerre_enabled) {
+    if (spec->balance_enabled || spec->laguerre_enabled) {
         if (gp_canceled(gp_progress_cancel(progress)))
-            rc = gp_error_set(err, GP_ECANCELED, NULL, "canceled before the laguerre stage");
+            rc = gp_error_set(err, GP_ECANCELED, NULL, "canceled after packing");
         else
-            rc = polyhedra(spec, &result->packing, &spec->laguerre, progress, &result->cells, result, err);
+            rc = on_triangulation(spec, &result->packing, spec->balance_enabled ? &result->balance : NULL,
+                                  spec->laguerre_enabled ? &spec->laguerre : NULL, progress,
+                                  &result->cells, result, err);
         if (rc) {
             gp_result3d_free(result);
             return rc;
         }
-        result->has_cells = 1;
+        result->has_balance = spec->balance_enabled;
+        result->has_cells = spec->laguerre_enabled;
     }
     t = now_seconds();
     if (gp_pack3d_stats_compute(&spec->box, &spec->dist, &result->packing, &result->stats) ||
@@ -120,7 +138,8 @@ int gp_result3d_power_cells(const gp_spec3d *spec, const gp_result3d *result, gp
                             gp_error *err)
 {
     gp_laguerre_params none = {GP_SHRINK_NONE, 0};
-    return polyhedra(spec, &result->packing, &none, NULL, out, NULL, err);
+    /* the packing is only read: without balancing nothing moves it */
+    return on_triangulation(spec, (gp_packing3d *)&result->packing, NULL, &none, NULL, out, NULL, err);
 }
 
 void gp_result3d_free(gp_result3d *result)
