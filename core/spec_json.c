@@ -109,3 +109,19 @@ json_t *gp_spec_json(const gp_spec *spec)
     }
     return in;
 }
+
+json_t *gp_spec3d_json(const gp_spec3d *spec)
+{
+    int failed = 0;
+    json_t *in = json_object();
+    put(in, "domain", json_pack("{s:f, s:f, s:f}", "width", spec->box.width, "height",
+                                spec->box.height, "depth", spec->box.depth), &failed);
+    put(in, "distribution", distribution_json(&spec->dist, &failed), &failed);
+    put(in, "joint", joint_json(&spec->joint, &failed), &failed);
+    put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
+    if (failed) {
+        json_decref(in);
+        return NULL;
+    }
+    return in;
+}

@@ -9,6 +9,7 @@
 #include "grainpack/domain.h"
 #include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
+#include "grainpack/pack3d.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -46,6 +47,12 @@ GP_API int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution 
                                  const gp_packing *packing, gp_pack_stats *out);
 
 GP_API void gp_pack_stats_free(gp_pack_stats *stats);
+
+/* The same statistics for a 3D packing in `box`: domain_area is then the box's volume and
+ * the densities are volume fractions (sum 4/3 pi R^3, sum 4/3 pi r^3 over it). Returns 0
+ * or GP_ENOMEM; `out` owns its bins (gp_pack_stats_free). */
+GP_API int gp_pack3d_stats_compute(const gp_box *box, const gp_distribution *dist,
+                                   const gp_packing3d *packing, gp_pack_stats *out);
 
 /* Bins of the cell-area histogram, over [min, max] of the areas. */
 #define GP_CELL_AREA_BINS 10
