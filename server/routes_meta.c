@@ -29,9 +29,9 @@ int gp_route_landing(gp_request *req, gp_reply *reply)
     json_t *body = json_pack(
         "{s:s, s:s, s:[o, o, o, o, o, o, o, o]}", "title", "grainpack",
         "description",
-        "Packs a rectangle with disks whose radii follow a distribution (advancing-front "
-        "method of INRIA report RR-6414), as asynchronous jobs in the style of OGC API - "
-        "Processes.",
+        "Packs a rectangle with disks (pack2d) or a box with spheres (pack3d) whose radii "
+        "follow a distribution (advancing-front method of INRIA report RR-6414), as "
+        "asynchronous jobs in the style of OGC API - Processes.",
         "links", make_link("/", "self", JSON_TYPE, "this document"),
         make_link("/?f=html", "alternate", "text/html", "the web page: design, run and look at jobs"),
         make_link("/openapi.yaml", "service-desc", "application/vnd.oai.openapi;version=3.1",
