@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include "grainpack/io.h"
+#include "grainpack/io3d.h"
 #include "grainpack/pipeline.h"
+#include "grainpack/pipeline3d.h"
 #include "grainpack/spec.h"
 #include "grainpack/spec3d.h"
 #include "grainpack/version.h"
@@ -32,11 +34,14 @@ static void usage(FILE *out)
           "\n"
           "  --process PROCESS    pack2d (disks in a rectangle) or pack3d (spheres in a box,\n"
           "                       docs/3d.md); by default pack3d when the spec's domain has\n"
-          "                       a \"depth\", else pack2d. pack3d packs and writes CSV\n"
-          "                       (x,y,z,r,R) only, for now\n"
-          "  -f, --format FORMAT  json (default), csv, svg, vtk (legacy VTK), or\n"
+          "                       a \"depth\", else pack2d\n"
+          "  -f, --format FORMAT  pack2d: json (default), csv, svg, vtk (legacy VTK), or\n"
           "                       vtu (VTK XML: the mesh, else the grains), msh (Gmsh 4.1),\n"
           "                       inp (Abaqus); msh and inp need \"mesh\" in the spec\n"
+          "                       pack3d: json (default), csv (x,y,z,r,R), vtu (VTK XML:\n"
+          "                       the polyhedra, else the sphere centres), tess (Neper's\n"
+          "                       tessellation; needs \"cells\" in the spec), svg (the\n"
+          "                       section of \"picture\": {\"section\": {\"axis\", \"at\"}})\n"
           "  -o FILE              write to FILE instead of standard output\n"
           "  --max-disks N        refuse specs expected to need more than N disks (or\n"
           "                       spheres; default 20000000)\n"
@@ -149,11 +154,6 @@ static int write_output(const char *out_path, int (*write)(gp_out *sink, const v
     return EXIT_FAILED;
 }
 
-static int write_spheres(gp_out *sink, const void *packing)
-{
-    return gp_write_spheres_csv(sink, packing);
-}
-
 /* What the 2D run writes. */
 typedef struct result_output {
     gp_format format;
@@ -167,8 +167,23 @@ static int write_result(gp_out *sink, const void *ctx)
     return gp_write_result(sink, what->format, what->spec, what->result);
 }
 
-/* The 3D process (docs/3d.md): packs the box and writes the spheres as CSV. */
-static int run3d(const spec_text *st, const char *out_path, size_t max_disks)
+/* What the 3D run writes. */
+typedef struct result3d_output {
+    gp_format3d format;
+    const gp_spec3d *spec;
+    const gp_result3d *result;
+    gp_error *err;
+} result3d_output;
+
+static int write_result3d(gp_out *sink, const void *ctx)
+{
+    const result3d_output *what = ctx;
+    return gp_write_result3d(sink, what->format, what->spec, what->result, what->err);
+}
+
+/* The 3D process (docs/3d.md): packs the box, runs the stages the spec asks for and
+ * writes the result in `format`. */
+static int run3d(const spec_text *st, gp_format3d format, const char *out_path, size_t max_disks)
 {
     gp_spec3d spec;
     int status = load_spec3d(st, max_disks, &spec);
@@ -177,11 +192,11 @@ static int run3d(const spec_text *st, const char *out_path, size_t max_disks)
     terminal_progress tp = {-1};
     gp_progress progress = {show_progress, &tp, NULL};
     int tty = isatty(STDERR_FILENO);
-    gp_pack3d_params params = gp_spec3d_pack_params(&spec, max_disks ? max_disks : GP_SPEC_DEFAULT_MAX_DISKS);
-    gp_packing3d packing;
+    gp_result3d result;
     gp_error err;
     gp_error_clear(&err);
-    int rc = gp_pack3d(&params, tty ? &progress : NULL, &packing, &err);
+    int rc = gp_pipeline3d_run(&spec, max_disks ? max_disks : GP_SPEC_DEFAULT_MAX_DISKS,
+                               tty ? &progress : NULL, &result, &err);
     if (tty)
         fputs("\r          \r", stderr);
     if (rc) {
@@ -189,11 +204,20 @@ static int run3d(const spec_text *st, const char *out_path, size_t max_disks)
         gp_spec3d_free(&spec);
         return EXIT_FAILED;
     }
+    if (gp_format3d_check(format, &result, &err)) {
+        fprintf(stderr, "grainpack: %s: --format %s: %s\n", st->path, gp_format3d_name(format), err.message);
+        gp_result3d_free(&result);
+        gp_spec3d_free(&spec);
+        return EXIT_USAGE;
+    }
     if (tty)
-        fprintf(stderr, "grainpack: %zu spheres, packing density %.4f\n", packing.count,
-                packing.fill_volume / (spec.box.width * spec.box.height * spec.box.depth));
-    status = write_output(out_path, write_spheres, &packing);
-    gp_packing3d_free(&packing);
+        fprintf(stderr, "grainpack: %zu spheres, packing density %.4f, %.1f ms\n", result.stats.count,
+                result.stats.packing_density, 1e3 * gp_result3d_stage_seconds(&result, "pack"));
+    result3d_output what = {format, &spec, &result, &err};
+    status = write_output(out_path, write_result3d, &what);
+    if (status && err.code)
+        fprintf(stderr, "grainpack: %s: %s\n", st->path, err.message);
+    gp_result3d_free(&result);
     gp_spec3d_free(&spec);
     return status;
 }
@@ -306,9 +330,8 @@ int main(int argc, char **argv)
         printf("grainpack %s\n", GP_VERSION);
         return EXIT_OK;
     }
-    const char *command = argv[1], *spec_path = NULL, *out_path = NULL;
-    gp_format format = GP_FORMAT_JSON;
-    int format_given = 0, process = -1;
+    const char *command = argv[1], *spec_path = NULL, *out_path = NULL, *format_name = "json";
+    int process = -1;
     size_t max_disks = 0, max_elements = 0;
     if (strcmp(command, "run") != 0 && strcmp(command, "validate") != 0) {
         fprintf(stderr, "grainpack: unknown command '%s'\n", command);
@@ -319,12 +342,7 @@ int main(int argc, char **argv)
         const char *arg = argv[i];
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         if ((strcmp(arg, "--format") == 0 || strcmp(arg, "-f") == 0) && value) {
-            if (gp_format_parse(value, &format)) {
-                fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg, vtk, vtu, msh "
-                                "or inp)\n", value);
-                return EXIT_USAGE;
-            }
-            format_given = 1;
+            format_name = value; /* parsed once the process is known */
             i++;
         } else if (strcmp(arg, "--process") == 0 && value) {
             if (strcmp(value, "pack2d") == 0) {
@@ -370,14 +388,21 @@ int main(int argc, char **argv)
     if (status)
         return status;
     int is3d = spec_process(st.text, st.len, process) == GP_PROCESS_PACK3D;
-    if (is3d && strcmp(command, "run") == 0 && format_given && format != GP_FORMAT_CSV) {
-        fprintf(stderr, "grainpack: the pack3d process writes csv only for now, not %s\n",
-                gp_format_name(format));
+    gp_format format = GP_FORMAT_JSON;
+    gp_format3d format3d = GP_FORMAT3D_JSON;
+    if (is3d && gp_format3d_parse(format_name, &format3d)) {
+        fprintf(stderr, "grainpack: unknown format '%s' for pack3d (expected json, csv, vtu, tess or "
+                        "svg)\n", format_name);
+        status = EXIT_USAGE;
+    } else if (!is3d && gp_format_parse(format_name, &format)) {
+        fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg, vtk, vtu, msh "
+                        "or inp)\n", format_name);
         status = EXIT_USAGE;
     } else if (strcmp(command, "validate") == 0) {
         status = is3d ? validate3d(&st, max_disks) : validate(&st, max_disks, max_elements);
     } else {
-        status = is3d ? run3d(&st, out_path, max_disks) : run(&st, format, out_path, max_disks, max_elements);
+        status = is3d ? run3d(&st, format3d, out_path, max_disks)
+                      : run(&st, format, out_path, max_disks, max_elements);
     }
     free(st.text);
     return status;

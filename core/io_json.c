@@ -16,7 +16,7 @@ static void put(json_t *obj, const char *key, json_t *value, int *failed)
 }
 
 /* The achieved-versus-target table: one object per bin. */
-static json_t *bins_json(const gp_bin_stat *table, size_t nbins, int *failed)
+json_t *gp_json_bins(const gp_bin_stat *table, size_t nbins, int *failed)
 {
     json_t *bins = json_array();
     if (!bins)
@@ -43,7 +43,7 @@ static json_t *bins_json(const gp_bin_stat *table, size_t nbins, int *failed)
 
 static json_t *distribution_json(const gp_pack_stats *st, int *failed)
 {
-    json_t *bins = bins_json(st->bins, st->nbins, failed);
+    json_t *bins = gp_json_bins(st->bins, st->nbins, failed);
     json_t *d = json_object();
     if (!d) {
         json_decref(bins);
@@ -69,7 +69,7 @@ json_t *gp_distribution_stats_json(const gp_pack_stats *st)
     return d;
 }
 
-static json_t *count_array(const size_t *counts, size_t n, int *failed)
+json_t *gp_json_counts(const size_t *counts, size_t n, int *failed)
 {
     json_t *a = json_array();
     for (size_t i = 0; a && i < n; i++)
@@ -91,11 +91,11 @@ static json_t *quality_json(const gp_quality_stats *q, int *failed)
     put(o, "min", json_real(q->min), failed);
     put(o, "max", json_real(q->max), failed);
     put(o, "mean", json_real(q->mean), failed);
-    put(o, "histogram", count_array(q->histogram, GP_QUALITY_BINS, failed), failed);
+    put(o, "histogram", gp_json_counts(q->histogram, GP_QUALITY_BINS, failed), failed);
     return o;
 }
 
-static json_t *balance_json(const gp_balance_result *b, int *failed)
+json_t *gp_json_balance(const gp_balance_result *b, int *failed)
 {
     json_t *o = json_object(), *t = json_object();
     if (!o || !t) {
@@ -143,10 +143,10 @@ static json_t *cells_json(const gp_spec *spec, const gp_cell_stats *c, int *fail
     put(area, "min", json_real(c->area_min), failed);
     put(area, "max", json_real(c->area_max), failed);
     put(area, "mean", json_real(c->area_mean), failed);
-    put(area, "histogram", count_array(c->area_histogram, GP_CELL_AREA_BINS, failed), failed);
+    put(area, "histogram", gp_json_counts(c->area_histogram, GP_CELL_AREA_BINS, failed), failed);
     put(o, "area", area, failed);
     put(nb, "mean", json_real(c->neighbours_mean), failed);
-    put(nb, "histogram", count_array(c->neighbour_histogram, c->max_neighbours + 1, failed), failed);
+    put(nb, "histogram", gp_json_counts(c->neighbour_histogram, c->max_neighbours + 1, failed), failed);
     put(o, "neighbours", nb, failed);
     put(o, "band_fraction", json_real(c->band_fraction), failed);
     put(o, "tiling_error", json_real(c->tiling_error), failed);
@@ -154,7 +154,7 @@ static json_t *cells_json(const gp_spec *spec, const gp_cell_stats *c, int *fail
     put(req, "max", json_real(c->req_max), failed);
     put(req, "mean", json_real(c->req_mean), failed);
     put(req, "mean_ratio", json_real(c->req_ratio_mean), failed);
-    put(req, "bins", bins_json(c->req_bins, c->nbins, failed), failed);
+    put(req, "bins", gp_json_bins(c->req_bins, c->nbins, failed), failed);
     put(req, "outside", json_integer((json_int_t)c->req_outside), failed);
     put(o, "equivalent_radius", req, failed);
     return o;
@@ -211,7 +211,7 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
     if (spec->domain.periodic)
         put(root, "periodic", periodic_json(spec->domain.periodic), &failed);
     if (result->has_balance)
-        put(root, "balance", balance_json(&result->balance, &failed), &failed);
+        put(root, "balance", gp_json_balance(&result->balance, &failed), &failed);
     if (result->has_cells)
         put(root, "cells", cells_json(spec, &result->cell_stats, &failed), &failed);
     if (result->has_mesh)

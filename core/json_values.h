@@ -38,4 +38,13 @@ json_t *gp_spec_json(const gp_spec *spec);
 /* The same for a 3D spec: domain (with its depth), distribution, joint, seed. */
 json_t *gp_spec3d_json(const gp_spec3d *spec);
 
+/* Parts of the above that the 3D writers share (NULL or *failed set when out of memory):
+ * the achieved-versus-target table, an array of counts, the balance summary, a law and a
+ * joint as the spec writes them. */
+json_t *gp_json_bins(const gp_bin_stat *table, size_t nbins, int *failed);
+json_t *gp_json_counts(const size_t *counts, size_t n, int *failed);
+json_t *gp_json_balance(const gp_balance_result *b, int *failed);
+json_t *gp_json_distribution(const gp_distribution *d, int *failed);
+json_t *gp_json_joint(const gp_joint *j, int *failed);
+
 #endif

@@ -808,9 +808,21 @@ int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx
 
 /* --- the 3D packing --- */
 
-int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *p,
-                               const gp_pack_stats *stats, gp_section *s, size_t *n)
+gp_pack_stats gp_pack3d_stats_view(const gp_pack3d_stats *st)
 {
+    return (gp_pack_stats){.count = st->count, .domain_area = st->box_volume,
+                           .packing_density = st->packing_density,
+                           .grain_fraction = st->grain_fraction, .r_min = st->r_min,
+                           .r_max = st->r_max, .r_mean = st->r_mean, .joint_min = st->joint_min,
+                           .joint_max = st->joint_max, .nbins = st->nbins, .bins = st->bins,
+                           .chi2 = st->chi2, .dof = st->dof, .p_value = st->p_value,
+                           .max_abs_z = st->max_abs_z};
+}
+
+int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *p,
+                               const gp_pack3d_stats *stats3d, gp_section *s, size_t *n)
+{
+    gp_pack_stats view = gp_pack3d_stats_view(stats3d), *stats = &view;
     *n = 0;
     enc e = {0};
     put_f64(&e, box->width);
@@ -849,7 +861,16 @@ int gp_section_decode_summary3d(const char *tag, uint32_t version, const void *d
     p->attempts = get_u64(&d);
     p->max_level = get_u32(&d);
     p->fill_volume = get_f64(&d);
-    int rc = get_stats(&d, &out->stats);
+    gp_pack_stats st = {0};
+    int rc = get_stats(&d, &st);
+    out->stats = (gp_pack3d_stats){.count = p->count, .box_volume = st.domain_area,
+                                   .packing_density = st.packing_density,
+                                   .grain_fraction = st.grain_fraction, .r_min = st.r_min,
+                                   .r_max = st.r_max, .r_mean = st.r_mean,
+                                   .joint_min = st.joint_min, .joint_max = st.joint_max,
+                                   .nbins = st.nbins, .bins = st.bins, .chi2 = st.chi2,
+                                   .dof = st.dof, .p_value = st.p_value,
+                                   .max_abs_z = st.max_abs_z};
     if (rc == 0 && (d.failed || d.left != 0))
         rc = GP_EPARSE;
     if (rc)
@@ -859,6 +880,6 @@ int gp_section_decode_summary3d(const char *tag, uint32_t version, const void *d
 
 void gp_summary3d_free(gp_summary3d *summary)
 {
-    gp_pack_stats_free(&summary->stats);
+    gp_pack3d_stats_free(&summary->stats);
     memset(summary, 0, sizeof *summary);
 }

@@ -47,6 +47,7 @@
 #include "grainpack/io.h"
 #include "grainpack/pack3d.h"
 #include "grainpack/pipeline.h"
+#include "grainpack/pipeline3d.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -137,14 +138,18 @@ void gp_sections_source_free(gp_sections_source *s);
 typedef struct gp_summary3d {
     gp_box box;
     gp_packing3d packing;
-    gp_pack_stats stats; /* owned (its bins) */
+    gp_pack3d_stats stats; /* owned (its bins) */
 } gp_summary3d;
+
+/* The 3D statistics seen as 2D's (box_volume as domain_area, the bins borrowed): what the
+ * store's columns and per-bin rows take from either. */
+gp_pack_stats gp_pack3d_stats_view(const gp_pack3d_stats *stats);
 
 /* Cuts a 3D packing into sections ("pack3d", "spheres"; at most GP_SECTIONS_MAX, *n of
  * them): the spheres borrowed from `packing`, which must outlive them. Returns 0 or
  * GP_ENOMEM (nothing left to free). Free with gp_sections_free. */
 int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *packing,
-                               const gp_pack_stats *stats, gp_section *sections, size_t *n);
+                               const gp_pack3d_stats *stats, gp_section *sections, size_t *n);
 
 /* Decodes a "pack3d" section into `out` (zeroed first; free with gp_summary3d_free).
  * Returns 0, GP_ENOMEM, GP_EPARSE (bytes not of the layout) or GP_EINVAL (another tag or

@@ -54,6 +54,41 @@ static int parse_box(validator *v, const json_t *inputs, const char *base, gp_bo
     return spec_get_number(v, obj, ptr, "depth", 0.0, 0, &box->depth);
 }
 
+/* "picture": {"section": {"axis": "x" | "y" | "z", "at": [0, 1]}}, both optional. */
+static int parse_picture(validator *v, const json_t *inputs, const char *base, gp_section3d *section)
+{
+    char ptr[GP_ERROR_POINTER_MAX], sptr[GP_ERROR_POINTER_MAX], field[GP_ERROR_POINTER_MAX];
+    const json_t *picture, *obj;
+    section->axis = GP_SECTION3D_DEFAULT_AXIS;
+    section->at = GP_SECTION3D_DEFAULT_AT;
+    int rc = spec_get_object(v, inputs, base, "picture", 0, &picture, ptr);
+    if (rc || !picture)
+        return rc;
+    static const char *const members[] = {"section", NULL};
+    if ((rc = spec_check_members(v, picture, ptr, members, "section (a 3D picture is a section)")) ||
+        (rc = spec_get_object(v, picture, ptr, "section", 0, &obj, sptr)) || !obj)
+        return rc;
+    static const char *const fields[] = {"axis", "at", NULL};
+    if ((rc = spec_check_members(v, obj, sptr, fields, "axis, at")))
+        return rc;
+    const json_t *axis = json_object_get(obj, "axis"), *at = json_object_get(obj, "at");
+    if (axis) {
+        const char *name = json_string_value(axis);
+        spec_pointer_key(field, sptr, "axis");
+        if (!name || strlen(name) != 1 || !strchr("xyz", name[0]))
+            return gp_error_set(v->err, GP_EINVAL, field, "must be \"x\", \"y\" or \"z\"");
+        section->axis = name[0] - 'x';
+    }
+    if (at) {
+        spec_pointer_key(field, sptr, "at");
+        if (!json_is_number(at) || !(json_number_value(at) >= 0.0 && json_number_value(at) <= 1.0))
+            return gp_error_set(v->err, GP_EINVAL, field,
+                                "must be a number in [0, 1]: the fraction of the box along the axis");
+        section->at = json_number_value(at);
+    }
+    return 0;
+}
+
 /* What spans the fields: the packer's own check (gp_pack3d_check, its pointer under
  * base), then the cap on the expected spheres. */
 static int check_whole(validator *v, const char *base, gp_spec3d *spec)
@@ -102,13 +137,14 @@ static int parse_root(validator *v, const json_t *root, void *out)
         if (!json_is_object(inputs))
             return gp_error_set(v->err, GP_EINVAL, "/inputs", "must be an object");
     }
-    static const char *const members[] = {"domain", "distribution", "joint", "seed", NULL};
+    static const char *const members[] = {"domain", "distribution", "joint", "seed", "picture", NULL};
     if ((rc = spec_check_members(v, inputs, base, members,
-                                 "domain, distribution, joint, seed (the 3D process takes no more yet)")) ||
+                                 "domain, distribution, joint, seed, picture")) ||
         (rc = parse_box(v, inputs, base, &spec->box)) ||
         (rc = spec_parse_distribution(v, inputs, base, &spec->dist)) ||
         (rc = spec_parse_joint(v, inputs, base, &spec->joint)) ||
-        (rc = spec_parse_seed(v, inputs, base, &spec->seed)) || (rc = check_whole(v, base, spec)))
+        (rc = spec_parse_seed(v, inputs, base, &spec->seed)) ||
+        (rc = parse_picture(v, inputs, base, &spec->section)) || (rc = check_whole(v, base, spec)))
         return rc;
     if (gp_distribution_prepare(&spec->dist))
         return gp_error_set(v->err, GP_ENOMEM, "", "out of memory");

@@ -13,7 +13,7 @@ static void put(json_t *obj, const char *key, json_t *value, int *failed)
     }
 }
 
-static json_t *distribution_json(const gp_distribution *d, int *failed)
+json_t *gp_json_distribution(const gp_distribution *d, int *failed)
 {
     json_t *o = json_object();
     switch (d->kind) {
@@ -40,7 +40,7 @@ static json_t *distribution_json(const gp_distribution *d, int *failed)
     return o;
 }
 
-static json_t *joint_json(const gp_joint *j, int *failed)
+json_t *gp_json_joint(const gp_joint *j, int *failed)
 {
     json_t *o = json_object();
     put(o, "law", json_string(gp_joint_law_name(j->law)), failed);
@@ -83,8 +83,8 @@ json_t *gp_spec_json(const gp_spec *spec)
     json_t *in = json_object();
     put(in, "domain", json_pack("{s:f, s:f}", "width", spec->domain.width, "height",
                                 spec->domain.height), &failed);
-    put(in, "distribution", distribution_json(&spec->dist, &failed), &failed);
-    put(in, "joint", joint_json(&spec->joint, &failed), &failed);
+    put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
+    put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
     /* the rule named, so that the densest default parses back as the default */
     put(in, "front", spec->level_band_set
@@ -112,13 +112,16 @@ json_t *gp_spec_json(const gp_spec *spec)
 
 json_t *gp_spec3d_json(const gp_spec3d *spec)
 {
+    static const char *const axes[] = {"x", "y", "z"};
     int failed = 0;
     json_t *in = json_object();
     put(in, "domain", json_pack("{s:f, s:f, s:f}", "width", spec->box.width, "height",
                                 spec->box.height, "depth", spec->box.depth), &failed);
-    put(in, "distribution", distribution_json(&spec->dist, &failed), &failed);
-    put(in, "joint", joint_json(&spec->joint, &failed), &failed);
+    put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
+    put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
+    put(in, "picture", json_pack("{s:{s:s, s:f}}", "section", "axis", axes[spec->section.axis],
+                                 "at", spec->section.at), &failed);
     if (failed) {
         json_decref(in);
         return NULL;

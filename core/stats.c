@@ -62,48 +62,14 @@ void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_
     }
 }
 
-/* Counts one grain of radius r and packing radius R into out (its radii, joints and bin);
- * i is its index (the first sets the extremes). */
-static void count_grain(gp_pack_stats *out, size_t i, double r, double R)
-{
-    if (i == 0 || r < out->r_min)
-        out->r_min = r;
-    if (i == 0 || r > out->r_max)
-        out->r_max = r;
-    double joint = R - r;
-    if (i == 0 || joint < out->joint_min)
-        out->joint_min = joint;
-    if (i == 0 || joint > out->joint_max)
-        out->joint_max = joint;
-    long b = gp_bin_table_find(out->bins, out->nbins, r);
-    if (b >= 0)
-        out->bins[b].count++;
-}
-
-/* The law's figures once every grain is counted: the bins' z and Pearson's chi-square. */
-static void finish_law(gp_pack_stats *out, size_t n)
-{
-    gp_bin_table_finish(out->bins, out->nbins, n, &out->max_abs_z);
-    int used = 0;
-    for (size_t i = 0; i < out->nbins; i++) {
-        const gp_bin_stat *b = &out->bins[i];
-        if (b->target > 0.0 && n) {
-            double expected = b->target * (double)n;
-            double diff = (double)b->count - expected;
-            out->chi2 += diff * diff / expected;
-            used++;
-        }
-    }
-    out->dof = used > 0 ? used - 1 : 0;
-    out->p_value = out->dof > 0 ? gp_chi2_upper_tail(out->chi2, out->dof) : 1.0;
-}
-
 int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
                           const gp_packing *packing, gp_pack_stats *out)
 {
     memset(out, 0, sizeof *out);
     if (gp_bin_table_init(dist, &out->bins, &out->nbins))
         return GP_ENOMEM;
+    size_t nbins = out->nbins;
+
     size_t n = packing->count;
     double sum_R2 = 0.0, sum_r2 = 0.0, sum_r = 0.0;
     out->count = n;
@@ -113,37 +79,44 @@ int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution *dist,
         sum_R2 += d->R * d->R;
         sum_r2 += d->r * d->r;
         sum_r += d->r;
-        count_grain(out, i, d->r, d->R);
+        if (i == 0 || d->r < out->r_min)
+            out->r_min = d->r;
+        if (i == 0 || d->r > out->r_max)
+            out->r_max = d->r;
+        double joint = d->R - d->r;
+        if (i == 0 || joint < out->joint_min)
+            out->joint_min = joint;
+        if (i == 0 || joint > out->joint_max)
+            out->joint_max = joint;
+        long b = gp_bin_table_find(out->bins, nbins, d->r);
+        if (b >= 0)
+            out->bins[b].count++;
     }
     out->packing_density = M_PI * sum_R2 / out->domain_area;
     out->grain_fraction = M_PI * sum_r2 / out->domain_area;
     out->r_mean = n ? sum_r / (double)n : 0.0;
-    finish_law(out, n);
+
+    gp_bin_table_finish(out->bins, nbins, n, &out->max_abs_z);
+    gp_bin_table_chi2(out->bins, nbins, n, &out->chi2, &out->dof, &out->p_value);
     return 0;
 }
 
-int gp_pack3d_stats_compute(const gp_box *box, const gp_distribution *dist,
-                            const gp_packing3d *packing, gp_pack_stats *out)
+void gp_bin_table_chi2(const gp_bin_stat *bins, size_t nbins, size_t n, double *chi2, int *dof,
+                       double *p_value)
 {
-    memset(out, 0, sizeof *out);
-    if (gp_bin_table_init(dist, &out->bins, &out->nbins))
-        return GP_ENOMEM;
-    size_t n = packing->count;
-    double sum_R3 = 0.0, sum_r3 = 0.0, sum_r = 0.0;
-    out->count = n;
-    out->domain_area = box->width * box->height * box->depth;
-    for (size_t i = 0; i < n; i++) {
-        const gp_sphere *s = &packing->spheres[i];
-        sum_R3 += s->R * s->R * s->R;
-        sum_r3 += s->r * s->r * s->r;
-        sum_r += s->r;
-        count_grain(out, i, s->r, s->R);
+    int used = 0;
+    *chi2 = 0.0;
+    for (size_t i = 0; i < nbins; i++) {
+        const gp_bin_stat *b = &bins[i];
+        if (b->target > 0.0 && n) {
+            double expected = b->target * (double)n;
+            double diff = (double)b->count - expected;
+            *chi2 += diff * diff / expected;
+            used++;
+        }
     }
-    out->packing_density = 4.0 / 3.0 * M_PI * sum_R3 / out->domain_area;
-    out->grain_fraction = 4.0 / 3.0 * M_PI * sum_r3 / out->domain_area;
-    out->r_mean = n ? sum_r / (double)n : 0.0;
-    finish_law(out, n);
-    return 0;
+    *dof = used > 0 ? used - 1 : 0;
+    *p_value = *dof > 0 ? gp_chi2_upper_tail(*chi2, *dof) : 1.0;
 }
 
 void gp_pack_stats_free(gp_pack_stats *stats)

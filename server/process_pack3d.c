@@ -8,8 +8,8 @@
 
 #include "download.h"
 #include "embedded.h"
+#include "grainpack/pipeline3d.h"
 #include "grainpack/spec3d.h"
-#include "grainpack/stats.h"
 #include "json_values.h"
 #include "log.h"
 #include "problem.h"
@@ -82,9 +82,8 @@ static int stages(const void *spec, const char **out, int cap)
 /* A run's own result: what the sections borrow from. */
 typedef struct pack3d_state {
     gp_box box;
-    gp_packing3d packing;
-    gp_pack_stats stats;
-    gp_stage_time timings[2];
+    gp_result3d result;
+    gp_pack_stats stats; /* result's statistics as the store takes them (bins borrowed) */
 } pack3d_state;
 
 static void free_run(gp_process_run *run)
@@ -92,8 +91,7 @@ static void free_run(gp_process_run *run)
     pack3d_state *st = run->state;
     gp_sections_free(run->sections, run->nsections);
     if (st) {
-        gp_packing3d_free(&st->packing);
-        gp_pack_stats_free(&st->stats);
+        gp_result3d_free(&st->result);
         free(st);
     }
     memset(run, 0, sizeof *run);
@@ -111,27 +109,20 @@ static int run(void *s, const gp_config *cfg, const gp_progress *progress, gp_pr
     st->box = spec->box;
     /* the sphere cap is the daemon's --max-disks, as the spec's estimate was checked
      * against it: a packing that outgrows the estimate stops there */
-    gp_pack3d_params params = gp_spec3d_pack_params(spec, cfg->max_disks);
-    double t0 = gp_monotonic_seconds();
-    int rc = gp_pack3d(&params, progress, &st->packing, err);
-    double t1 = gp_monotonic_seconds();
-    if (rc == 0 && gp_pack3d_stats_compute(&spec->box, &spec->dist, &st->packing, &st->stats))
-        rc = gp_error_set(err, GP_ENOMEM, "", "out of memory");
-    double t2 = gp_monotonic_seconds();
-    if (rc == 0 && gp_sections_from_packing3d(&st->box, &st->packing, &st->stats, out->sections,
-                                              &out->nsections))
+    int rc = gp_pipeline3d_run(spec, cfg->max_disks, progress, &st->result, err);
+    if (rc == 0 && gp_sections_from_packing3d(&st->box, &st->result.packing, &st->result.stats,
+                                              out->sections, &out->nsections))
         rc = gp_error_set(err, GP_ENOMEM, "", "out of memory");
     if (rc) {
         free_run(out);
         return rc;
     }
-    st->timings[0] = (gp_stage_time){"pack3d", t1 - t0};
-    st->timings[1] = (gp_stage_time){"stats", t2 - t1};
-    out->count = st->packing.count;
-    out->density = st->stats.packing_density;
-    out->outcome = (gp_outcome){out->sections, out->nsections, &st->stats, 0,
-                                st->packing.attempts, 0, 0, 0, st->packing.max_level, "spheres",
-                                st->timings, 2};
+    const gp_result3d *r = &st->result;
+    st->stats = gp_pack3d_stats_view(&r->stats);
+    out->count = r->packing.count;
+    out->density = r->stats.packing_density;
+    out->outcome = (gp_outcome){out->sections, out->nsections, &st->stats, 0, r->packing.attempts,
+                                0, 0, 0, r->packing.max_level, "spheres", r->timings, r->ntimings};
     return 0;
 }
 
@@ -153,19 +144,21 @@ static int stored_summary(const gp_stored_result *res, gp_summary3d *out)
     return GP_EPARSE;
 }
 
-/* The statistics document of a 3D result: the spheres' densities (volume fractions),
- * radii, the law's bins and how the front went. NULL when out of memory. */
+/* The statistics document of a 3D result, as gp_write_json3d writes it (io_json3d.c):
+ * the spheres' densities (volume fractions), radii and joints, the law's bins and how the
+ * front went. NULL when out of memory. */
 static json_t *summary_json(const gp_summary3d *sum, uint64_t seed)
 {
-    const gp_pack_stats *st = &sum->stats;
+    const gp_pack3d_stats *st = &sum->stats;
     const gp_packing3d *pk = &sum->packing;
-    return json_pack("{s:s, s:I, s:{s:f, s:f, s:f}, s:f, s:f, s:f, s:{s:f, s:f, s:f}, s:o*, "
+    gp_pack_stats view = gp_pack3d_stats_view(st);
+    return json_pack("{s:I, s:f, s:f, s:f, s:{s:f, s:f, s:f}, s:{s:f, s:f}, s:o*, "
                      "s:{s:I, s:I, s:I, s:I}, s:I}",
-                     "process", "pack3d", "count", (json_int_t)st->count, "box", "width", sum->box.width, "height",
-                     sum->box.height, "depth", sum->box.depth, "domain_volume", st->domain_area,
+                     "count", (json_int_t)st->count, "box_volume", st->box_volume,
                      "packing_density", st->packing_density, "grain_fraction", st->grain_fraction,
-                     "radius", "min", st->r_min, "max", st->r_max, "mean", st->r_mean,
-                     "distribution", gp_distribution_stats_json(st), "front", "wall_spheres",
+                     "radius", "min", st->r_min, "max", st->r_max, "mean", st->r_mean, "joint",
+                     "min", st->joint_min, "max", st->joint_max, "distribution",
+                     gp_distribution_stats_json(&view), "front", "wall_spheres",
                      (json_int_t)pk->wall_spheres, "triangles", (json_int_t)pk->triangles,
                      "attempts", (json_int_t)pk->attempts, "max_level", (json_int_t)pk->max_level,
                      "seed", (json_int_t)seed);
@@ -228,27 +221,34 @@ static void write_head(spheres_text *t, gp_out *text)
         gp_out_puts(text, "x,y,z,r,R\n");
         return;
     }
-    gp_out_puts(text, "{\"process\":\"pack3d\",\"inputs\":");
+    /* as gp_write_json3d: the head's members one a line, then the spheres */
+    GP_OUT_LITERAL(text, "{\n\"process\": \"pack3d\",\n\"inputs\": ");
     gp_out_json(text, t->inputs);
-    gp_out_puts(text, ",\"statistics\":");
+    GP_OUT_LITERAL(text, ",\n\"statistics\": ");
     gp_out_json(text, t->stats);
-    gp_out_puts(text, ",\"spheres\":[");
+    GP_OUT_LITERAL(text, ",\n\"spheres\": [");
 }
 
-/* One sphere: "x,y,z,r,R\n" in CSV (as gp_write_spheres_csv), [x,y,z,r,R] in JSON; the
- * shortest decimals that read back exactly. */
+/* One sphere: "x,y,z,r,R\n" in CSV (as gp_write_spheres_csv), {"id", "x", "y", "z", "r",
+ * "R"} in JSON (as gp_write_json3d); the shortest decimals that read back exactly. */
 static void write_sphere(const spheres_text *t, gp_out *text, size_t i, const gp_sphere *s)
 {
     const double v[5] = {s->x, s->y, s->z, s->r, s->R};
+    static const char *const json_names[5] = {",\"x\":", ",\"y\":", ",\"z\":", ",\"r\":",
+                                              ",\"R\":"};
     int json = t->format == GP_FORMAT_JSON;
-    if (json)
-        gp_out_puts(text, i ? ",[" : "[");
+    if (json) {
+        gp_out_puts(text, i ? ",\n{\"id\":" : "\n{\"id\":");
+        gp_out_uint(text, i);
+    }
     for (int k = 0; k < 5; k++) {
-        if (k)
+        if (json)
+            gp_out_puts(text, json_names[k]);
+        else if (k)
             gp_out_char(text, ',');
         gp_out_double(text, v[k]);
     }
-    gp_out_char(text, json ? ']' : '\n');
+    gp_out_char(text, json ? '}' : '\n');
 }
 
 static int spheres_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text,
@@ -271,7 +271,7 @@ static int spheres_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_ou
     }
     if (t->next == t->count && !t->done) {
         if (t->format == GP_FORMAT_JSON)
-            gp_out_puts(text, "]}");
+            GP_OUT_LITERAL(text, "\n]\n}\n");
         t->done = 1;
     }
     return t->done ? 0 : 1;

@@ -36,7 +36,7 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(path, "w") as f:
         json.dump(SPEC, f)
     out = os.path.join(tmp, "box.csv")
-    rc, _, err = run(["run", path, "-o", out])
+    rc, _, err = run(["run", path, "-f", "csv", "-o", out])
     check(rc == 0, "run exited %d: %s" % (rc, err))
     with open(out, newline="") as f:
         rows = list(csv.reader(f))
@@ -57,7 +57,7 @@ with tempfile.TemporaryDirectory() as tmp:
     # stdin gives the same bytes, --process pack3d changes nothing, validate agrees
     with open(out, "rb") as f:
         expected = f.read()
-    rc, got, _ = run(["run", "-"], stdin=json.dumps(SPEC).encode())
+    rc, got, _ = run(["run", "-", "--format", "csv"], stdin=json.dumps(SPEC).encode())
     check(rc == 0 and got == expected, "stdin run differs")
     rc, got, _ = run(["run", path, "--process", "pack3d", "-f", "csv"])
     check(rc == 0 and got == expected, "--process pack3d differs")
@@ -79,7 +79,10 @@ with tempfile.TemporaryDirectory() as tmp:
     refused({"domain": box, "distribution": law, "balance": {}}, 3, "/balance")
     refused({"inputs": {"domain": dict(box, depth="deep"), "distribution": law}}, 3,
             "/inputs/domain/depth")
-    refused({"domain": box, "distribution": law}, 2, "csv only", ["-f", "json"])
+    refused({"domain": box, "distribution": law}, 2, "unknown format 'vtk' for pack3d", ["-f", "vtk"])
+    # JSON by default, as in 2D
+    rc, got, _ = run(["run", path])
+    check(rc == 0 and json.loads(got)["process"] == "pack3d", "default format: %d" % rc)
     # a 2D spec asked for as pack3d: the depth is missing; a 3D one as pack2d: depth unknown
     rc, _, err = run(["run", os.path.join(EXAMPLES, "iron.json"), "--process", "pack3d"])
     check(rc == 3 and "/inputs/domain/depth" in err, "2D spec as pack3d: %d %s" % (rc, err))

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "grainpack/spec3d.h"
+#include "grainpack/pipeline3d.h"
 #include "json_values.h"
 #include "sections.h"
 #include "packing_checks.h"
@@ -328,10 +328,10 @@ static void test_pack3d_sections(void)
     gp_pack3d_params params = gp_spec3d_pack_params(&spec, 0);
     gp_packing3d p;
     CHECK_MSG(gp_pack3d(&params, NULL, &p, &err) == 0, "%s", err.message);
-    gp_pack_stats st;
+    gp_pack3d_stats st;
     CHECK(gp_pack3d_stats_compute(&spec.box, &spec.dist, &p, &st) == 0);
     double volume = spec.box.width * spec.box.height * spec.box.depth;
-    CHECK(st.count == p.count && p.count > 50 && st.domain_area == volume);
+    CHECK(st.count == p.count && p.count > 50 && st.box_volume == volume);
     CHECK_MSG(fabs(st.packing_density - p.fill_volume / volume) < 1e-12 * st.packing_density,
               "density %.17g, fill %.17g", st.packing_density, p.fill_volume / volume);
     size_t binned = 0;
@@ -366,7 +366,7 @@ static void test_pack3d_sections(void)
         CHECK(gp_section_decode_summary(sec[i].tag, sec[i].version, sec[i].data, sec[i].size, &summary) == 0);
     CHECK(summary.packing.count == 0);
     gp_sections_free(sec, n);
-    gp_pack_stats_free(&st);
+    gp_pack3d_stats_free(&st);
     gp_packing3d_free(&p);
     gp_spec3d_free(&spec);
 }

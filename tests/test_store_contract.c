@@ -18,8 +18,7 @@
 
 #include "check.h"
 #include "grainpack/spec.h"
-#include "grainpack/spec3d.h"
-#include "grainpack/stats.h"
+#include "grainpack/pipeline3d.h"
 #include "log.h"
 #include "sections.h"
 #include "store.h"
@@ -182,7 +181,7 @@ static void test_a_pack3d_outcome_is_stored_and_read_back(void)
     CHECK(gp_spec3d_parse(text, strlen(text), NULL, &spec, &err) == 0);
     gp_pack3d_params params = gp_spec3d_pack_params(&spec, 0);
     gp_packing3d p;
-    gp_pack_stats st;
+    gp_pack3d_stats st;
     CHECK(gp_pack3d(&params, NULL, &p, &err) == 0 && p.count > 20);
     CHECK(gp_pack3d_stats_compute(&spec.box, &spec.dist, &p, &st) == 0);
     gp_job_columns columns = {"pack3d", 6, 6, "constant", "none", 0, 2, spec.expected_spheres, 0};
@@ -195,7 +194,8 @@ static void test_a_pack3d_outcome_is_stored_and_read_back(void)
     size_t n;
     CHECK(gp_sections_from_packing3d(&spec.box, &p, &st, sec, &n) == 0);
     gp_stage_time timings[1] = {{"pack3d", 0.25}};
-    gp_outcome outcome = {sec, n, &st, 0, p.attempts, 0, 0, 0, p.max_level, "spheres", timings, 1};
+    gp_pack_stats view = gp_pack3d_stats_view(&st);
+    gp_outcome outcome = {sec, n, &view, 0, p.attempts, 0, 0, 0, p.max_level, "spheres", timings, 1};
     CHECK(gp_store_finish_outcome(db, id, &outcome) == 0);
     CHECK(gp_store_get_job(db, id, NULL, &got) == 0 && got.status == GP_JOB_SUCCESSFUL &&
           strcmp(got.process, "pack3d") == 0 && strstr(got.message, " spheres, packing density "));
@@ -220,7 +220,7 @@ static void test_a_pack3d_outcome_is_stored_and_read_back(void)
     double seconds[2];
     CHECK(gp_store_load_timings(db, id, names, seconds, 2) == 1 && strcmp(names[0], "pack3d") == 0);
     gp_sections_free(sec, n);
-    gp_pack_stats_free(&st);
+    gp_pack3d_stats_free(&st);
     gp_packing3d_free(&p);
     gp_spec3d_free(&spec);
     gp_store_release(store, db);

@@ -18,12 +18,24 @@
 extern "C" {
 #endif
 
+/* The plane of the section picture (docs/3d.md §8): normal to `axis` (0 x, 1 y, 2 z), at
+ * the fraction `at` in [0, 1] of the box along it. */
+typedef struct gp_section3d {
+    int axis;
+    double at;
+} gp_section3d;
+
+/* The section picture's default: across z, through the middle of the box. */
+#define GP_SECTION3D_DEFAULT_AXIS 2
+#define GP_SECTION3D_DEFAULT_AT 0.5
+
 typedef struct gp_spec3d {
     gp_box box;
     gp_distribution dist;    /* owned; prepared for sampling */
     gp_joint joint;          /* GP_JOINT_NONE when the spec has none */
     uint64_t seed;
     double expected_spheres; /* a density of 0.64 over the mean packing-sphere volume */
+    gp_section3d section;    /* "picture": {"section": {"axis", "at"}} */
 } gp_spec3d;
 
 /* The processes a spec may ask for. */
@@ -38,7 +50,8 @@ typedef enum gp_process {
 GP_API gp_process gp_spec_process(const char *text, size_t len);
 
 /* Parses and validates a 3D spec: {"inputs": {...}} or the bare inputs, with "domain"
- * {"width", "height", "depth"}, "distribution", "joint" (optional), "seed" (optional).
+ * {"width", "height", "depth"}, "distribution", "joint" (optional), "seed" (optional), "picture" (optional:
+ * {"section": {"axis": "x" | "y" | "z", "at": a fraction in [0, 1]}}, default z at 0.5).
  * `limits` may be NULL; its max_disks caps the expected number of spheres. On success
  * returns 0 and `spec` owns its law (gp_spec3d_free). On failure returns GP_EPARSE,
  * GP_EINVAL or GP_ETOOBIG with err's pointer on the field, and leaves `spec` zeroed. */

@@ -9,7 +9,6 @@
 #include "grainpack/domain.h"
 #include "grainpack/laguerre.h"
 #include "grainpack/pack.h"
-#include "grainpack/pack3d.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,12 +46,6 @@ GP_API int gp_pack_stats_compute(const gp_domain *domain, const gp_distribution 
                                  const gp_packing *packing, gp_pack_stats *out);
 
 GP_API void gp_pack_stats_free(gp_pack_stats *stats);
-
-/* The same statistics for a 3D packing in `box`: domain_area is then the box's volume and
- * the densities are volume fractions (sum 4/3 pi R^3, sum 4/3 pi r^3 over it). Returns 0
- * or GP_ENOMEM; `out` owns its bins (gp_pack_stats_free). */
-GP_API int gp_pack3d_stats_compute(const gp_box *box, const gp_distribution *dist,
-                                   const gp_packing3d *packing, gp_pack_stats *out);
 
 /* Bins of the cell-area histogram, over [min, max] of the areas. */
 #define GP_CELL_AREA_BINS 10
@@ -95,6 +88,11 @@ GP_API long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
 
 /* Fills `achieved`, `se` and `z` of every bin from its count out of n values, and *max_abs_z. */
 GP_API void gp_bin_table_finish(gp_bin_stat *bins, size_t nbins, size_t n, double *max_abs_z);
+
+/* Pearson's chi-square of the counts of n values against the targets, over the bins with
+ * a target > 0, its degrees of freedom (those bins less one) and p-value (1 when dof is 0). */
+GP_API void gp_bin_table_chi2(const gp_bin_stat *bins, size_t nbins, size_t n, double *chi2, int *dof,
+                              double *p_value);
 
 /* The upper tail P(X >= x) of a chi-square law with dof degrees of freedom (dof >= 1). */
 GP_API double gp_chi2_upper_tail(double x, int dof);

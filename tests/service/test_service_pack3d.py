@@ -11,14 +11,18 @@ spheres and statistics, the gzip download the same bytes, and none of the downlo
 the pipeline again; a format it does not serve is 400. A pack3d job too large for
 --max-disks is refused before it is stored, one past --max-job-seconds fails with a time
 limit, a dismissed one stops, and a finished one is deleted with its results. Responses
-are checked against openapi.yaml.
-Usage: test_service_pack3d.py GRAINPACKD"""
+are checked against openapi.yaml. The JSON and CSV downloads are byte for byte what
+`grainpack run` writes for the same spec.
+Usage: test_service_pack3d.py GRAINPACKD GRAINPACK"""
 
 import csv
 import gzip
 import io
 import json
 import math
+import os
+import subprocess
+import tempfile
 
 import gpd
 
@@ -137,7 +141,11 @@ def pipeline_runs(client):
     return gpd.metric(client.get("/metrics").body.decode(), "grainpack_pipeline_runs_total")
 
 
-def check_job(c, api, client):
+def plain_csv(client, job):
+    return client.get(f"/jobs/{job}/results?f=csv").body
+
+
+def check_job(c, api, client, cli):
     r = client.submit(spec3d(), "pack3d")
     api.check(c, "POST", "/processes/{processId}/execution", r)
     c.check(r.status == 201 and r.json()["processID"] == "pack3d", f"submission: {r}")
@@ -167,21 +175,32 @@ def check_job(c, api, client):
             "a radius outside the law, or a joint other than 0.05")
     volume = BOX["width"] * BOX["height"] * BOX["depth"]
     density = sum(4 / 3 * math.pi * s[4] ** 3 for s in spheres) / volume
-    c.check(abs(density - st["packing_density"]) < 1e-12 and st["domain_volume"] == volume,
+    c.check(abs(density - st["packing_density"]) < 1e-12 and st["box_volume"] == volume,
             f"density {density} against the statistics' {st['packing_density']}")
     bins = st["distribution"]["bins"]
     c.check(sum(b["count"] for b in bins) == len(spheres) and
             all(b["count"] == sum(1 for s in spheres if b["min"] <= s[3] < b["max"] or
                                   (b is bins[-1] and s[3] == b["max"])) for b in bins),
             "the statistics' bin counts are not the CSV's")
-    c.check([t["stage"] for t in st["timings"]] == ["pack3d", "stats"] and st["process"] == "pack3d",
+    c.check([t["stage"] for t in st["timings"]] == ["pack", "stats"],
             f"statistics: {st['timings']}")
 
     r = client.get(f"/jobs/{job}/results?f=json")
     api.check(c, "GET", "/jobs/{jobId}/results", r)
     doc = r.json()
-    c.check([tuple(s) for s in doc["spheres"]] == spheres and doc["inputs"]["domain"] == BOX,
+    c.check([(s["x"], s["y"], s["z"], s["r"], s["R"]) for s in doc["spheres"]] == spheres and
+            [s["id"] for s in doc["spheres"]] == list(range(len(spheres))) and
+            doc["process"] == "pack3d" and doc["inputs"]["domain"] == BOX,
             "the JSON download's spheres differ from the CSV's")
+    # the very bytes the command line writes for the same spec
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "box.json")
+        with open(path, "w") as f:
+            json.dump(spec3d(), f)
+        for fmt, body in (("json", r.body), ("csv", plain_csv(client, job))):
+            made = subprocess.run([cli, "run", path, "-f", fmt], capture_output=True, check=True).stdout
+            c.check(body == made, f"{fmt}: the download ({len(body)} bytes) is not what grainpack run "
+                                  f"writes ({len(made)} bytes)")
     stats = {k: v for k, v in st.items() if k not in ("jobID", "timings", "total_seconds")}
     c.check(doc["statistics"] == stats, "the JSON download's statistics differ from /statistics")
     plain = client.get(f"/jobs/{job}/results?f=csv").body
@@ -218,7 +237,7 @@ def check_limits(c, client):
     c.check(client.wait_final(job)["status"] == "dismissed", "the dismissed job did not stay dismissed")
 
 
-def test(c, binary):
+def test(c, binary, cli):
     api = gpd.OpenAPI()
     daemon = gpd.Daemon(binary, "--max-disks", str(MAX_SPHERES), "--max-job-seconds", "1",
                         "--workers", "1")
@@ -228,7 +247,7 @@ def test(c, binary):
         check_processes(c, api, client)
         check_refusals(c, api, client)
         check_validation(c, api, client)
-        check_job(c, api, client)
+        check_job(c, api, client, cli)
         check_limits(c, client)
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
         gpd.check_store(c, daemon, "after the pack3d jobs")

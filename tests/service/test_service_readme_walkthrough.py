@@ -49,7 +49,7 @@ def test(c, binary):
                          "x,y,r,R", '"packing_density"', '"timings"', "\n304\n", '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
                          'grainpack_jobs{status="successful",node="', "openapi: 3.1.0", "$MeshFormat\n4.1 0 8",
-                         '"processID":"pack3d"', "x,y,z,r,R\n", '"domain_volume":1000']:
+                         '"processID":"pack3d"', "x,y,z,r,R\n", '"box_volume":1000']:
             c.check(expected in out, f"walk-through output lacks {expected!r}")
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:
