@@ -58,6 +58,17 @@ static json_t *distribution_json(const gp_pack_stats *st, int *failed)
     return d;
 }
 
+json_t *gp_distribution_stats_json(const gp_pack_stats *st)
+{
+    int failed = 0;
+    json_t *d = distribution_json(st, &failed);
+    if (failed) {
+        json_decref(d);
+        return NULL;
+    }
+    return d;
+}
+
 json_t *gp_json_counts(const size_t *counts, size_t n, int *failed)
 {
     json_t *a = json_array();

@@ -11,6 +11,7 @@
 #include "grainpack/out.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
+#include "grainpack/spec3d.h"
 
 /* The statistics of a result as a new JSON object (caller owns the reference; NULL when
  * out of memory): count, densities, radii, the per-bin target-versus-achieved table with
@@ -18,6 +19,11 @@
  * reproducible); the caller adds them where it wants them. Reads only the result's
  * summary (no per-grain array): a result read back from a store serves as well. */
 json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result);
+
+/* The statistics' "distribution" object of st (its bins against the law, chi2, dof,
+ * p_value, max_abs_z), for any process's statistics. A new reference, or NULL when out of
+ * memory. */
+json_t *gp_distribution_stats_json(const gp_pack_stats *st);
 
 /* Writes a JSON value compactly, doubles in their shortest round-trip form (jansson's
  * own dump writes 17 digits, 0.059999999999999998 for 0.06). For small documents: the
@@ -28,6 +34,9 @@ void gp_out_json(gp_out *out, const json_t *value);
  * options, picture): parsed again it gives the same spec. Returns a new reference the
  * caller owns, or NULL when out of memory. */
 json_t *gp_spec_json(const gp_spec *spec);
+
+/* The same for a 3D spec: domain (with its depth), distribution, joint, seed. */
+json_t *gp_spec3d_json(const gp_spec3d *spec);
 
 /* Parts of the above that the 3D writers share (NULL or *failed set when out of memory):
  * the achieved-versus-target table, an array of counts, the balance summary, a law and a

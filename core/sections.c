@@ -12,6 +12,7 @@
 #error "sections.c stores little-endian layouts as they lie in memory: a big-endian port must swap"
 #endif
 _Static_assert(sizeof(gp_disk) == 32, "a disk is stored as four doubles");
+_Static_assert(sizeof(gp_sphere) == 40, "a sphere is stored as five doubles");
 
 /* The version of every section's layout this build writes (and the only one it reads). */
 #define LAYOUT_V1 1
@@ -77,6 +78,8 @@ static void put_quality(enc *e, const gp_quality_stats *q)
     put_counts(e, q->histogram, GP_QUALITY_BINS);
 }
 
+static void put_stats(enc *e, const gp_pack_stats *s);
+
 static void encode_pack(enc *e, const gp_result *r)
 {
     const gp_packing *p = &r->packing;
@@ -92,6 +95,12 @@ static void encode_pack(enc *e, const gp_result *r)
     put_u32(e, p->wait_levels);
     put_f64(e, p->alive_quantile);
     put_f64(e, p->fill_area);
+    put_stats(e, s);
+}
+
+/* The statistics of a packing (2D or 3D) against its law. */
+static void put_stats(enc *e, const gp_pack_stats *s)
+{
     put_f64(e, s->domain_area);
     put_f64(e, s->packing_density);
     put_f64(e, s->grain_fraction);
@@ -369,6 +378,8 @@ static void get_quality(dec *d, gp_quality_stats *q)
     get_counts(d, q->histogram, GP_QUALITY_BINS);
 }
 
+static int get_stats(dec *d, gp_pack_stats *s);
+
 static int decode_pack(dec *d, gp_result *r)
 {
     gp_packing *p = &r->packing;
@@ -389,6 +400,12 @@ static int decode_pack(dec *d, gp_result *r)
     p->wait_levels = get_u32(d);
     p->alive_quantile = get_f64(d);
     p->fill_area = get_f64(d);
+    return get_stats(d, s);
+}
+
+/* The statistics of a packing (2D or 3D), as put_stats wrote them. */
+static int get_stats(dec *d, gp_pack_stats *s)
+{
     s->domain_area = get_f64(d);
     s->packing_density = get_f64(d);
     s->grain_fraction = get_f64(d);
@@ -787,4 +804,82 @@ int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx
     m->bedge = p[5];
     m->bedge_side = p[6];
     return 0;
+}
+
+/* --- the 3D packing --- */
+
+gp_pack_stats gp_pack3d_stats_view(const gp_pack3d_stats *st)
+{
+    return (gp_pack_stats){.count = st->count, .domain_area = st->box_volume,
+                           .packing_density = st->packing_density,
+                           .grain_fraction = st->grain_fraction, .r_min = st->r_min,
+                           .r_max = st->r_max, .r_mean = st->r_mean, .joint_min = st->joint_min,
+                           .joint_max = st->joint_max, .nbins = st->nbins, .bins = st->bins,
+                           .chi2 = st->chi2, .dof = st->dof, .p_value = st->p_value,
+                           .max_abs_z = st->max_abs_z};
+}
+
+int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *p,
+                               const gp_pack3d_stats *stats3d, gp_section *s, size_t *n)
+{
+    gp_pack_stats view = gp_pack3d_stats_view(stats3d), *stats = &view;
+    *n = 0;
+    enc e = {0};
+    put_f64(&e, box->width);
+    put_f64(&e, box->height);
+    put_f64(&e, box->depth);
+    put_u64(&e, p->count);
+    put_u64(&e, p->wall_spheres);
+    put_u64(&e, p->triangles);
+    put_u64(&e, p->attempts);
+    put_u32(&e, p->max_level);
+    put_f64(&e, p->fill_volume);
+    put_stats(&e, stats);
+    if (e.failed) {
+        free(e.buf);
+        return GP_ENOMEM;
+    }
+    add(s, n, GP_SECTION_PACK3D, 1, NULL, 0, &e);
+    add(s, n, GP_SECTION_SPHERES, 0, p->spheres, p->count * sizeof(gp_sphere), NULL);
+    return 0;
+}
+
+int gp_section_decode_summary3d(const char *tag, uint32_t version, const void *data, size_t size,
+                                gp_summary3d *out)
+{
+    memset(out, 0, sizeof *out);
+    if (strcmp(tag, GP_SECTION_PACK3D) != 0 || version != LAYOUT_V1)
+        return GP_EINVAL;
+    dec d = {data, size, 0};
+    out->box.width = get_f64(&d);
+    out->box.height = get_f64(&d);
+    out->box.depth = get_f64(&d);
+    gp_packing3d *p = &out->packing;
+    p->count = out->stats.count = get_size(&d);
+    p->wall_spheres = get_size(&d);
+    p->triangles = get_u64(&d);
+    p->attempts = get_u64(&d);
+    p->max_level = get_u32(&d);
+    p->fill_volume = get_f64(&d);
+    gp_pack_stats st = {0};
+    int rc = get_stats(&d, &st);
+    out->stats = (gp_pack3d_stats){.count = p->count, .box_volume = st.domain_area,
+                                   .packing_density = st.packing_density,
+                                   .grain_fraction = st.grain_fraction, .r_min = st.r_min,
+                                   .r_max = st.r_max, .r_mean = st.r_mean,
+                                   .joint_min = st.joint_min, .joint_max = st.joint_max,
+                                   .nbins = st.nbins, .bins = st.bins, .chi2 = st.chi2,
+                                   .dof = st.dof, .p_value = st.p_value,
+                                   .max_abs_z = st.max_abs_z};
+    if (rc == 0 && (d.failed || d.left != 0))
+        rc = GP_EPARSE;
+    if (rc)
+        gp_summary3d_free(out);
+    return rc;
+}
+
+void gp_summary3d_free(gp_summary3d *summary)
+{
+    gp_pack3d_stats_free(&summary->stats);
+    memset(summary, 0, sizeof *summary);
 }

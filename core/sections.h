@@ -25,7 +25,13 @@
  *   "mesh_quad_region" per quadrilateral: its region (i32)
  *   "mesh_bedge"      per boundary edge: its order + 1 node indices (i32)
  *   "mesh_bedge_side" per boundary edge: its gp_mesh_side (u8)
- * The small sections ("pack", "balance", "cells", "mesh") make a result's summary: the statistics
+ * The 3D process (pack3d, docs/3d.md) stores:
+ *   "pack3d"          the box, the front's counters (spheres, wall spheres, triangles,
+ *                     attempts, max level, fill volume) and the statistics of the spheres
+ *                     (gp_pack_stats: domain_area is the box's volume, the densities are
+ *                     volume fractions)
+ *   "spheres"         per grain: x, y, z, r, R (f64 each, 40 bytes)
+ * The small sections ("pack", "balance", "cells", "mesh", "pack3d") make a result's summary: the statistics
  * and everything a writer needs but the per-grain arrays, which a writer reads window by
  * window through gp_sections_source (below) without holding the whole result.
  *
@@ -39,7 +45,9 @@
 #include <stdint.h>
 
 #include "grainpack/io.h"
+#include "grainpack/pack3d.h"
 #include "grainpack/pipeline.h"
+#include "grainpack/pipeline3d.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -62,6 +70,8 @@ extern "C" {
 #define GP_SECTION_MESH_QUAD_REGION "mesh_quad_region"
 #define GP_SECTION_MESH_BEDGE "mesh_bedge"
 #define GP_SECTION_MESH_BEDGE_SIDE "mesh_bedge_side"
+#define GP_SECTION_PACK3D "pack3d"
+#define GP_SECTION_SPHERES "spheres"
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24
@@ -122,6 +132,31 @@ gp_sections_source *gp_sections_source_new(const gp_result *summary, gp_section_
 /* The source for gp_writer_new; valid while `s` lives. */
 gp_grain_source gp_sections_source_grains(gp_sections_source *s);
 void gp_sections_source_free(gp_sections_source *s);
+
+/* The summary of a 3D packing: the box, the packing's counters (spheres NULL) and the
+ * statistics of its spheres against the law. */
+typedef struct gp_summary3d {
+    gp_box box;
+    gp_packing3d packing;
+    gp_pack3d_stats stats; /* owned (its bins) */
+} gp_summary3d;
+
+/* The 3D statistics seen as 2D's (box_volume as domain_area, the bins borrowed): what the
+ * store's columns and per-bin rows take from either. */
+gp_pack_stats gp_pack3d_stats_view(const gp_pack3d_stats *stats);
+
+/* Cuts a 3D packing into sections ("pack3d", "spheres"; at most GP_SECTIONS_MAX, *n of
+ * them): the spheres borrowed from `packing`, which must outlive them. Returns 0 or
+ * GP_ENOMEM (nothing left to free). Free with gp_sections_free. */
+int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *packing,
+                               const gp_pack3d_stats *stats, gp_section *sections, size_t *n);
+
+/* Decodes a "pack3d" section into `out` (zeroed first; free with gp_summary3d_free).
+ * Returns 0, GP_ENOMEM, GP_EPARSE (bytes not of the layout) or GP_EINVAL (another tag or
+ * an unknown version). */
+int gp_section_decode_summary3d(const char *tag, uint32_t version, const void *data, size_t size,
+                                gp_summary3d *out);
+void gp_summary3d_free(gp_summary3d *summary);
 
 #ifdef __cplusplus
 }

@@ -109,3 +109,22 @@ json_t *gp_spec_json(const gp_spec *spec)
     }
     return in;
 }
+
+json_t *gp_spec3d_json(const gp_spec3d *spec)
+{
+    static const char *const axes[] = {"x", "y", "z"};
+    int failed = 0;
+    json_t *in = json_object();
+    put(in, "domain", json_pack("{s:f, s:f, s:f}", "width", spec->box.width, "height",
+                                spec->box.height, "depth", spec->box.depth), &failed);
+    put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
+    put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
+    put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
+    put(in, "picture", json_pack("{s:{s:s, s:f}}", "section", "axis", axes[spec->section.axis],
+                                 "at", spec->section.at), &failed);
+    if (failed) {
+        json_decref(in);
+        return NULL;
+    }
+    return in;
+}

@@ -9,6 +9,7 @@
 
 #include "sections.h"
 #include "log.h"
+#include "render.h"
 
 /* What the writer renders in one go: libmicrohttpd asks for as much as is free in its
  * buffer, often a few hundred bytes; rendering that little each time would cost a store
@@ -31,6 +32,8 @@ typedef struct gp_download {
     gp_sections_source *whole; /* VTU's grains, read in one window (io_mesh_plan.c) */
     int loaded;                /* what the mesh formats read whole is in res.summary */
     gp_writer *writer;
+    gp_download_renderer renderer; /* instead of writer, for another process's result */
+    const char *name;              /* of the format, for the log */
     gp_out text;       /* rendered; bytes from `sent` on not handed on yet */
     size_t sent;
     gp_db *db;         /* held during one fill only */
@@ -90,15 +93,19 @@ static int render(gp_download *d, size_t want)
         return GP_SRV_EDB;
     }
     int rc = 0;
-    if (!d->loaded) {
-        rc = load_whole(d);
-        d->loaded = rc == 0;
+    if (d->renderer.run) {
+        rc = d->renderer.run(d->renderer.ctx, read_section, d, &d->text, want);
+    } else {
+        if (!d->loaded) {
+            rc = load_whole(d);
+            d->loaded = rc == 0;
+        }
+        if (rc == 0)
+            rc = gp_writer_run(d->writer, &d->text, want);
     }
-    if (rc == 0)
-        rc = gp_writer_run(d->writer, &d->text, want);
     if (rc < 0) {
         gp_log("download: rendering %s of a stored result failed (%d): the download is cut short",
-               gp_format_name(d->format), rc);
+               d->name, rc);
         return rc;
     }
     d->rendered = rc == 0;
@@ -169,6 +176,8 @@ static void release(gp_body_stream *s)
     if (d->z_open)
         deflateEnd(&d->z);
     gp_writer_free(d->writer);
+    if (d->renderer.free)
+        d->renderer.free(d->renderer.ctx);
     gp_sections_source_free(d->source);
     if (d->whole) { /* the grains lent to the summary are the window's */
         gp_result *r = &d->res.summary;
@@ -187,37 +196,106 @@ static void release(gp_body_stream *s)
     free(d);
 }
 
-int gp_download_new(gp_service *svc, gp_stored_result *res, gp_spec *spec, gp_format format,
-                    int gzip, gp_body_stream **out)
+/* A download of res (taken over) without its renderer yet: NULL when out of memory (res
+ * is then freed). */
+static gp_download *download_new(gp_service *svc, gp_stored_result *res, int gzip)
 {
-    *out = NULL;
     gp_download *d = calloc(1, sizeof *d);
     if (!d) {
         gp_stored_result_free(res);
-        gp_spec_free(spec);
-        return GP_ENOMEM;
+        return NULL;
     }
     d->stream = (gp_body_stream){fill, release};
     d->svc = svc;
     d->res = *res;
     memset(res, 0, sizeof *res);
-    d->spec = *spec;
-    memset(spec, 0, sizeof *spec);
-    d->format = format;
     d->gzip = gzip;
     gp_metrics_download(svc->metrics, 1);
-    gp_grain_source grains;
     if (gp_out_init(&d->text, 2 * RENDER_BATCH, NULL, NULL) ||
-        !(d->reader = gp_result_reader_new(d->res.key)) ||
-        !(d->source = gp_sections_source_new(&d->res.summary, read_section, d, 0)) ||
-        (grains = gp_sections_source_grains(d->source),
-         !(d->writer = gp_writer_new(format, &d->spec, &d->res.summary, &grains))) ||
-        (gzip && deflateInit2(&d->z, GP_DOWNLOAD_GZIP_LEVEL, Z_DEFLATED, GZIP_WINDOW_BITS,
-                              GZIP_MEM_LEVEL, Z_DEFAULT_STRATEGY) != Z_OK)) {
+        !(d->reader = gp_result_reader_new(d->res.key))) {
+        release(&d->stream);
+        return NULL;
+    }
+    return d;
+}
+
+/* Opens the compressor when asked and hands the stream out. Returns 0 or GP_ENOMEM (then
+ * everything is freed). */
+static int download_start(gp_download *d, gp_body_stream **out)
+{
+    if (d->gzip && deflateInit2(&d->z, GP_DOWNLOAD_GZIP_LEVEL, Z_DEFLATED, GZIP_WINDOW_BITS,
+                                GZIP_MEM_LEVEL, Z_DEFAULT_STRATEGY) != Z_OK) {
         release(&d->stream);
         return GP_ENOMEM;
     }
-    d->z_open = gzip;
+    d->z_open = d->gzip;
     *out = &d->stream;
     return 0;
+}
+
+int gp_download_new(gp_service *svc, gp_stored_result *res, gp_spec *spec, gp_format format,
+                    int gzip, gp_body_stream **out)
+{
+    *out = NULL;
+    gp_download *d = download_new(svc, res, gzip);
+    if (!d) {
+        gp_spec_free(spec);
+        return GP_ENOMEM;
+    }
+    d->spec = *spec;
+    memset(spec, 0, sizeof *spec);
+    d->format = format;
+    d->name = gp_format_name(format);
+    gp_grain_source grains;
+    if (!(d->source = gp_sections_source_new(&d->res.summary, read_section, d, 0)) ||
+        (grains = gp_sections_source_grains(d->source),
+         !(d->writer = gp_writer_new(format, &d->spec, &d->res.summary, &grains)))) {
+        release(&d->stream);
+        return GP_ENOMEM;
+    }
+    return download_start(d, out);
+}
+
+int gp_download_new_renderer(gp_service *svc, gp_stored_result *res, gp_download_renderer renderer,
+                             const char *name, int gzip, gp_body_stream **out)
+{
+    *out = NULL;
+    gp_download *d = download_new(svc, res, gzip);
+    if (!d) {
+        if (renderer.free)
+            renderer.free(renderer.ctx);
+        return GP_ENOMEM;
+    }
+    d->renderer = renderer;
+    d->name = name;
+    return download_start(d, out);
+}
+
+int gp_download_headers(gp_request *req, const char *etag, const char *ext, int gzip,
+                        gp_reply *reply)
+{
+    gp_reply_header_add(reply, "ETag", "%s", etag);
+    /* the bytes depend on Accept (the format, without ?f=) and Accept-Encoding */
+    gp_reply_header_add(reply, "Vary", "Accept, Accept-Encoding");
+    /* a result never changes but may be deleted, and is per key: ask again each time,
+     * which a 304 makes cheap */
+    gp_reply_header_add(reply, "Cache-Control", "private, no-cache");
+    if (gp_render_not_modified(req, etag)) {
+        gp_reply_take(reply, 304, NULL, NULL, 0);
+        return 1;
+    }
+    gp_reply_header_add(reply, "Content-Disposition", "attachment; filename=\"job-%s.%s\"",
+                        req->id, ext);
+    if (gzip)
+        gp_reply_header_add(reply, "Content-Encoding", "gzip");
+    return 0;
+}
+
+void gp_download_reply(gp_request *req, gp_body_stream *stream, const char *type, gp_reply *reply)
+{
+    gp_reply_stream(reply, 200, type, stream);
+    /* libmicrohttpd 0.9.75 ends the headers of a HEAD answer to a chunked response with
+     * the last chunk ("0\r\n\r\n") although HEAD has no body: a client reusing the
+     * connection would read it as the next status line, so the connection closes */
+    reply->close = strcmp(req->method, "HEAD") == 0;
 }

@@ -1,6 +1,6 @@
 /* embedded.h - files of the repository compiled into the daemon (embed.cmake makes
  * embedded_files.c and web_files.c at build time): the OpenAPI document, the process
- * description, and the web page's files (server/web/) with the report's examples. */
+ * descriptions, and the web page's files (server/web/) with the report's examples. */
 #ifndef GRAINPACKD_EMBEDDED_H
 #define GRAINPACKD_EMBEDDED_H
 
@@ -10,6 +10,8 @@ extern const unsigned char gp_openapi_yaml[];
 extern const size_t gp_openapi_yaml_len;
 extern const unsigned char gp_process_pack2d_json[];
 extern const size_t gp_process_pack2d_json_len;
+extern const unsigned char gp_process_pack3d_json[];
+extern const size_t gp_process_pack3d_json_len;
 
 /* One served file: its name under /ui/, its bytes and a strong ETag (quoted). */
 typedef struct gp_embedded_file {

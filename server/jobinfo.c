@@ -4,6 +4,7 @@
 #include <stdio.h>
 
 #include "grainpack/io.h"
+#include "processes.h"
 #include "routes.h"
 
 #define OGC_RESULTS_REL "http://www.opengis.net/def/rel/ogc/1.0/results"
@@ -22,6 +23,9 @@ json_t *gp_job_status_info(const gp_job *job)
     snprintf(stats, sizeof stats, "/jobs/%s/statistics", job->id);
     json_t *links = json_pack("[{s:s, s:s, s:s, s:s}]", "href", self, "rel", "self", "type",
                               "application/json", "title", "this job's status");
+    const gp_process_def *process = gp_process_find(job->process);
+    if (!process)
+        process = &gp_process_pack2d;
     if (links && job->status == GP_JOB_SUCCESSFUL) {
         json_array_append_new(links,
                               json_pack("{s:s, s:s, s:s, s:s}", "href", results, "rel",
@@ -31,7 +35,7 @@ json_t *gp_job_status_info(const gp_job *job)
          * knowing them: a format the engine gains appears here by itself */
         for (size_t i = 0; i < gp_format_count(); i++) {
             gp_format f = (gp_format)i;
-            if (f == GP_FORMAT_JSON || (gp_format_needs_mesh(f) && !job->has_mesh))
+            if (f == GP_FORMAT_JSON || !process->serves(f, job->has_mesh))
                 continue;
             char href[96], title[48];
             snprintf(href, sizeof href, "%s?f=%s", results, gp_format_name(f));
@@ -44,7 +48,7 @@ json_t *gp_job_status_info(const gp_job *job)
                                                "statistics", "type", "application/json", "title",
                                                "densities, distribution fidelity, timings"));
     }
-    json_t *info = json_pack("{s:s, s:s, s:s, s:s, s:s, s:i, s:o}", "processID", GP_PROCESS_ID,
+    json_t *info = json_pack("{s:s, s:s, s:s, s:s, s:s, s:i, s:o}", "processID", process->id,
                              "type", "process", "jobID", job->id, "status",
                              gp_job_status_name(job->status), "message", job->message,
                              "progress", job->progress, "links", links);

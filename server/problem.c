@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "processes.h"
 #include "store.h"
 
 static const char *status_title(unsigned status)
@@ -136,8 +137,12 @@ void gp_problem_no_such_job(gp_reply *reply, const char *instance, const char *i
 
 void gp_problem_no_such_process(gp_reply *reply, const char *instance, const char *id)
 {
+    char offered[128] = "";
+    for (size_t i = 0, len = 0; i < gp_process_count() && len < sizeof offered; i++)
+        len += (size_t)snprintf(offered + len, sizeof offered - len, "%s'%s'", i ? ", " : "",
+                                gp_process_at(i)->id);
     gp_problem(reply, 404, GP_PROBLEM_NO_SUCH_PROCESS, instance,
-               "there is no process '%s'; this service offers 'pack2d'", id);
+               "there is no process '%.60s'; this service offers %s", id, offered);
 }
 
 void gp_problem_store_unavailable(gp_reply *reply, const char *instance)

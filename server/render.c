@@ -154,7 +154,7 @@ void gp_render_etag(const gp_stored_result *res, const gp_spec *spec, gp_format 
                     char *out)
 {
     /* only the picture shows the colouring (?color= or the spec's) */
-    const char *color = format != GP_FORMAT_SVG ? ""
+    const char *color = format != GP_FORMAT_SVG || !spec ? ""
                         : spec->picture_color == GP_PICTURE_COLOR_QUALITY ? "-quality"
                                                                          : "-radius";
     snprintf(out, GP_ETAG_SIZE, "\"%s-%s%s%s-%s.%d\"", res->version, gp_format_name(format),

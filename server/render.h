@@ -32,6 +32,7 @@ int gp_render_accepts_gzip(const gp_request *req);
  * `spec` (the job's, with the request's overrides such as ?color=) renders it: the stored
  * result's version, the format, the picture's colouring for the SVG, the encoding, and
  * the build's version and writer revision, so that different bytes never share a tag.
+ * `spec` is NULL for a process whose pictures have no colouring choice.
  * `out` has room for GP_ETAG_SIZE bytes. */
 #define GP_ETAG_SIZE 112
 void gp_render_etag(const gp_stored_result *res, const gp_spec *spec, gp_format format, int gzip,

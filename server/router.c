@@ -7,6 +7,7 @@
 #include <strings.h>
 
 #include "problem.h"
+#include "processes.h"
 #include "routes.h"
 
 #define BEARER_REALM "Bearer realm=\"grainpack\""
@@ -174,7 +175,7 @@ int gp_router_admit(gp_request *req, const gp_route_entry *rt, size_t uri_bytes,
         return 1;
     if (!is_post)
         return 0;
-    if (strcmp(req->id, GP_PROCESS_ID) != 0) { /* before the body: it would not be used */
+    if (!gp_process_find(req->id)) { /* before the body: it would not be used */
         gp_problem_no_such_process(reply, url, req->id);
         return 1;
     }

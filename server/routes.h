@@ -32,7 +32,4 @@ int gp_route_web_file(gp_request *req, gp_reply *reply);
 int gp_route_web_page(gp_request *req, gp_reply *reply);
 int gp_route_web_wants_page(const gp_request *req, gp_reply *reply);
 
-/* The process this service offers. */
-#define GP_PROCESS_ID "pack2d"
-
 #endif

@@ -6,11 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "grainpack/spec.h"
 #include "jobinfo.h"
-#include "json_values.h"
 #include "log.h"
 #include "problem.h"
+#include "processes.h"
 #include "routes.h"
 #include "workers.h"
 
@@ -39,40 +38,25 @@ static int query_count(const gp_request *req, const char *name, long long lo, lo
     return 0;
 }
 
-/* Parses the body as a spec under the service's caps. Returns 0 with spec filled (the
- * caller frees it), or -1 with the 400/422 problem in reply. */
-static int parse_spec(gp_request *req, gp_spec *spec, gp_reply *reply)
+/* The process of the path's {processId}; NULL with a 404 in reply when there is none. */
+static const gp_process_def *find_process(const gp_request *req, gp_reply *reply)
 {
-    gp_spec_limits limits = {req->svc->cfg->max_disks, req->svc->cfg->max_bins,
-                             req->svc->cfg->max_elements};
-    gp_error err;
-    gp_error_clear(&err);
-    if (gp_spec_parse(req->body, req->body_len, &limits, spec, &err)) {
-        gp_problem_from_spec_error(reply, req->path, &err);
-        return -1;
-    }
-    return 0;
+    const gp_process_def *process = gp_process_find(req->id);
+    if (!process)
+        gp_problem_no_such_process(reply, req->path, req->id);
+    return process;
 }
 
 int gp_route_validate(gp_request *req, gp_reply *reply)
 {
-    gp_service *svc = req->svc;
-    gp_spec spec;
-    if (strcmp(req->id, GP_PROCESS_ID) != 0) {
-        gp_problem_no_such_process(reply, req->path, req->id);
-        return GP_ROUTE_DONE;
-    }
-    if (parse_spec(req, &spec, reply))
+    const gp_process_def *process = find_process(req, reply);
+    void *spec;
+    if (!process || gp_process_parse_request(process, req, &spec, reply))
         return GP_ROUTE_DONE;
     /* nothing is stored or queued: the answer is what a submission would be accepted as */
-    json_t *body = json_pack("{s:b, s:I, s:o*, s:{s:I, s:I, s:I}}", "valid", 1, "expected_disks",
-                             (json_int_t)llround(spec.expected_disks), "inputs", gp_spec_json(&spec),
-                             "limits", "max_disks", (json_int_t)svc->cfg->max_disks, "max_bins",
-                             (json_int_t)svc->cfg->max_bins, "max_elements",
-                             (json_int_t)svc->cfg->max_elements);
-    gp_spec_free(&spec);
-    if (!body || !json_object_get(body, "inputs")) {
-        json_decref(body);
+    json_t *body = process->validation(spec, req->svc->cfg);
+    process->free_spec(spec);
+    if (!body) {
         gp_problem(reply, 500, GP_PROBLEM_INTERNAL, req->path, "out of memory");
         return GP_ROUTE_DONE;
     }
@@ -83,24 +67,25 @@ int gp_route_validate(gp_request *req, gp_reply *reply)
 int gp_route_execute(gp_request *req, gp_reply *reply)
 {
     gp_service *svc = req->svc;
-    if (strcmp(req->id, GP_PROCESS_ID) != 0) {
-        gp_problem_no_such_process(reply, req->path, req->id);
+    const gp_process_def *process = find_process(req, reply);
+    if (!process)
         return GP_ROUTE_DONE;
-    }
     if (!atomic_load(&svc->accepting)) {
         gp_problem(reply, 503, GP_PROBLEM_SHUTTING_DOWN, req->path,
                    "the service is shutting down and accepts no new jobs");
         reply->retry_after = GP_RETRY_AFTER_SECONDS;
         return GP_ROUTE_DONE;
     }
-    gp_spec spec;
-    if (parse_spec(req, &spec, reply))
+    void *spec;
+    if (gp_process_parse_request(process, req, &spec, reply))
         return GP_ROUTE_DONE;
+    gp_job_columns columns;
+    process->columns(spec, &columns);
     /* reserve a queue place first, so that concurrent submissions cannot overshoot */
     long before = atomic_fetch_add(&svc->queued, 1);
     if (before >= (long)svc->cfg->max_queued) {
         atomic_fetch_sub(&svc->queued, 1);
-        gp_spec_free(&spec);
+        process->free_spec(spec);
         gp_problem(reply, 503, GP_PROBLEM_QUEUE_FULL, req->path,
                    "%ld jobs are waiting, the limit (--max-queued) is %zu; try again later",
                    before, svc->cfg->max_queued);
@@ -113,12 +98,12 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
     gp_job job;
     long active = 0;
     gp_db *db = gp_store_acquire(svc->store, 1);
-    int rc = db ? gp_store_insert_job(db, owner, max_active, req->body, req->body_len, &spec, &job,
-                                      &active)
+    int rc = db ? gp_store_insert_job_columns(db, owner, max_active, req->body, req->body_len,
+                                              &columns, &job, &active)
                 : GP_SRV_EDB;
     gp_store_release(svc->store, db);
-    double expected = spec.expected_disks;
-    gp_spec_free(&spec);
+    double expected = columns.expected;
+    process->free_spec(spec);
     if (rc == GP_SRV_ELIMIT) {
         atomic_fetch_sub(&svc->queued, 1);
         gp_problem(reply, 429, GP_PROBLEM_TOO_MANY_JOBS, req->path,
@@ -133,8 +118,8 @@ int gp_route_execute(gp_request *req, gp_reply *reply)
         gp_problem_store_error(reply, req->path, rc, "the job was not stored");
         return GP_ROUTE_DONE;
     }
-    gp_log("job %s accepted from %s: about %.0f disks expected", job.id, owner[0] ? owner : "-",
-           expected);
+    gp_log("job %s accepted from %s: %s, about %.0f %s expected", job.id, owner[0] ? owner : "-",
+           process->id, expected, process->noun);
     gp_pool_notify(svc->pool);
     snprintf(reply->location, sizeof reply->location, "/jobs/%s", job.id);
     gp_reply_json(reply, 201, JSON_TYPE, gp_job_status_info(&job));

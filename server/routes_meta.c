@@ -6,6 +6,7 @@
 #include "grainpack/version.h"
 #include "log.h"
 #include "problem.h"
+#include "processes.h"
 #include "routes.h"
 #include "workers.h"
 
@@ -28,9 +29,9 @@ int gp_route_landing(gp_request *req, gp_reply *reply)
     json_t *body = json_pack(
         "{s:s, s:s, s:[o, o, o, o, o, o, o, o]}", "title", "grainpack",
         "description",
-        "Packs a rectangle with disks whose radii follow a distribution (advancing-front "
-        "method of INRIA report RR-6414), as asynchronous jobs in the style of OGC API - "
-        "Processes.",
+        "Packs a rectangle with disks (pack2d) or a box with spheres (pack3d) whose radii "
+        "follow a distribution (advancing-front method of INRIA report RR-6414), as "
+        "asynchronous jobs in the style of OGC API - Processes.",
         "links", make_link("/", "self", JSON_TYPE, "this document"),
         make_link("/?f=html", "alternate", "text/html", "the web page: design, run and look at jobs"),
         make_link("/openapi.yaml", "service-desc", "application/vnd.oai.openapi;version=3.1",
@@ -54,22 +55,23 @@ int gp_route_conformance(gp_request *req, gp_reply *reply)
     return GP_ROUTE_DONE;
 }
 
-/* The process description (server/process-pack2d.json, compiled in); NULL on error. */
-static json_t *process_description(void)
-{
-    json_error_t err;
-    return json_loadb((const char *)gp_process_pack2d_json, gp_process_pack2d_json_len, 0, &err);
-}
-
 int gp_route_processes(gp_request *req, gp_reply *reply)
 {
     (void)req;
-    json_t *summary = process_description();
-    if (summary) { /* a summary is the description without inputs and outputs */
+    json_t *list = json_array();
+    for (size_t i = 0; list && i < gp_process_count(); i++) {
+        json_t *summary = gp_process_description(gp_process_at(i));
+        if (!summary) {
+            json_decref(list);
+            list = NULL;
+            break;
+        }
+        /* a summary is the description without inputs and outputs */
         json_object_del(summary, "inputs");
         json_object_del(summary, "outputs");
+        json_array_append_new(list, summary);
     }
-    json_t *body = json_pack("{s:[o], s:[o]}", "processes", summary, "links",
+    json_t *body = json_pack("{s:o, s:[o]}", "processes", list, "links",
                              make_link("/processes", "self", JSON_TYPE, "this document"));
     gp_reply_json(reply, 200, JSON_TYPE, body);
     return GP_ROUTE_DONE;
@@ -77,11 +79,12 @@ int gp_route_processes(gp_request *req, gp_reply *reply)
 
 int gp_route_process(gp_request *req, gp_reply *reply)
 {
-    if (strcmp(req->id, GP_PROCESS_ID) != 0) {
+    const gp_process_def *process = gp_process_find(req->id);
+    if (!process) {
         gp_problem_no_such_process(reply, req->path, req->id);
         return GP_ROUTE_DONE;
     }
-    gp_reply_json(reply, 200, JSON_TYPE, process_description());
+    gp_reply_json(reply, 200, JSON_TYPE, gp_process_description(process));
     return GP_ROUTE_DONE;
 }
 

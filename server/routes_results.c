@@ -5,9 +5,8 @@
 #include <string.h>
 
 #include "grainpack/io.h"
-#include "download.h"
-#include "json_values.h"
 #include "problem.h"
+#include "processes.h"
 #include "render.h"
 #include "routes.h"
 
@@ -39,9 +38,9 @@ static int without_result(gp_request *req, gp_db *db, gp_reply *reply)
     return 1;
 }
 
-/* Opens the job's stored result and parses its spec; 1 with a problem in reply when there
- * is none. On 0 the caller frees res and spec. */
-static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp_reply *reply)
+/* Opens the job's stored result; 1 with a problem in reply when there is none. On 0 the
+ * caller frees res. */
+static int open_result(gp_request *req, gp_stored_result *res, gp_reply *reply)
 {
     gp_db *db = gp_store_acquire(req->svc->store, 1);
     if (!db) {
@@ -57,11 +56,6 @@ static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp
     gp_store_release(req->svc->store, db);
     if (missing)
         return 1;
-    gp_error err;
-    /* accepted once, so parsed without today's caps */
-    gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
-    if (rc == 0 && (rc = gp_spec_parse(res->spec_text, res->spec_len, &unlimited, spec, &err)))
-        gp_stored_result_free(res);
     if (rc == GP_ENOMEM) {
         gp_problem_out_of_memory(reply);
         return 1;
@@ -75,88 +69,22 @@ static int open_result(gp_request *req, gp_stored_result *res, gp_spec *spec, gp
     return 0;
 }
 
-/* Reads ?color=radius|quality, what the picture is coloured by (the spec's choice when
- * absent). Returns 0 with *color set, or -1 with a 400 in reply. */
-static int picture_color(const gp_request *req, int *color, gp_reply *reply)
-{
-    const char *text = gp_request_query(req, "color");
-    *color = -1;
-    if (!text)
-        return 0;
-    if (strcmp(text, "radius") == 0 || strcmp(text, "quality") == 0) {
-        *color = strcmp(text, "radius") == 0 ? GP_PICTURE_COLOR_RADIUS : GP_PICTURE_COLOR_QUALITY;
-        return 0;
-    }
-    gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
-               "color must be radius or quality (F, for a job that balanced), got '%.40s'", text);
-    return -1;
-}
-
 int gp_route_results(gp_request *req, gp_reply *reply)
 {
     gp_format format;
-    int color;
-    if (gp_render_choose_format(req, &format, reply) || picture_color(req, &color, reply))
+    if (gp_render_choose_format(req, &format, reply))
         return GP_ROUTE_DONE;
     gp_stored_result res;
-    gp_spec spec;
-    if (open_result(req, &res, &spec, reply))
+    if (open_result(req, &res, reply))
         return GP_ROUTE_DONE;
-    if (color == GP_PICTURE_COLOR_QUALITY && !res.summary.has_balance) {
-        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
-                   "color=quality colours the grains by F, which only a job that balances has; "
-                   "job %s has no balance stage (color=radius)", req->id);
-        gp_stored_result_free(&res);
-        gp_spec_free(&spec);
-        return GP_ROUTE_DONE;
-    }
-    if (gp_format_needs_mesh(format) && !res.summary.has_mesh) {
-        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
-                   "f=%s is the job's finite-element mesh; job %s has none (its spec has no "
-                   "\"mesh\"): json, csv, svg, vtk or vtu", gp_format_name(format), req->id);
-        gp_stored_result_free(&res);
-        gp_spec_free(&spec);
-        return GP_ROUTE_DONE;
-    }
-    if (color >= 0)
-        spec.picture_color = (gp_picture_color)color;
-    int gzip = gp_format_is_text(format) && gp_render_accepts_gzip(req);
-    char etag[GP_ETAG_SIZE];
-    gp_render_etag(&res, &spec, format, gzip, etag);
-    gp_reply_header_add(reply, "ETag", "%s", etag);
-    /* the bytes depend on Accept (the format, without ?f=) and Accept-Encoding */
-    gp_reply_header_add(reply, "Vary", "Accept, Accept-Encoding");
-    /* a result never changes but may be deleted, and is per key: ask again each time,
-     * which a 304 makes cheap */
-    gp_reply_header_add(reply, "Cache-Control", "private, no-cache");
-    if (gp_render_not_modified(req, etag)) {
-        gp_stored_result_free(&res);
-        gp_spec_free(&spec);
-        gp_reply_take(reply, 304, NULL, NULL, 0);
-        return GP_ROUTE_DONE;
-    }
-    gp_reply_header_add(reply, "Content-Disposition", "attachment; filename=\"job-%s.%s\"",
-                        req->id, gp_format_name(format));
-    if (gzip)
-        gp_reply_header_add(reply, "Content-Encoding", "gzip");
-    gp_body_stream *stream;
-    if (gp_download_new(req->svc, &res, &spec, format, gzip, &stream) == 0) {
-        gp_reply_stream(reply, 200, gp_format_media_type(format), stream);
-        /* libmicrohttpd 0.9.75 ends the headers of a HEAD answer to a chunked response with
-         * the last chunk ("0\r\n\r\n") although HEAD has no body: a client reusing the
-         * connection would read it as the next status line, so the connection closes */
-        reply->close = strcmp(req->method, "HEAD") == 0;
-    } else {
-        gp_problem_out_of_memory(reply); /* drops the headers above */
-    }
-    return GP_ROUTE_DONE;
+    /* the job's process serves it (and takes res over) */
+    return gp_process_of_spec(res.spec_text, res.spec_len)->results(req, &res, format, reply);
 }
 
 int gp_route_statistics(gp_request *req, gp_reply *reply)
 {
     gp_stored_result res;
-    gp_spec spec;
-    if (open_result(req, &res, &spec, reply))
+    if (open_result(req, &res, reply))
         return GP_ROUTE_DONE;
     char names[GP_MAX_STAGES][32];
     double seconds[GP_MAX_STAGES];
@@ -165,7 +93,7 @@ int gp_route_statistics(gp_request *req, gp_reply *reply)
     if (db)
         ntimings = gp_store_load_timings(db, req->id, names, seconds, GP_MAX_STAGES);
     gp_store_release(req->svc->store, db);
-    json_t *stats = gp_statistics_json(&spec, &res.summary);
+    json_t *stats = gp_process_of_spec(res.spec_text, res.spec_len)->statistics(&res);
     json_t *timings = json_array();
     double total = 0.0;
     for (int i = 0; timings && i < ntimings; i++) {
@@ -182,6 +110,5 @@ int gp_route_statistics(gp_request *req, gp_reply *reply)
     }
     gp_reply_json(reply, 200, JSON_TYPE, stats);
     gp_stored_result_free(&res);
-    gp_spec_free(&spec);
     return GP_ROUTE_DONE;
 }

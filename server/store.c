@@ -107,7 +107,7 @@ void gp_store_conns_remove(gp_store_conns *c, void *db)
     }
 }
 
-void gp_store_new_job(gp_job *out, const gp_spec *spec)
+void gp_store_new_job(gp_job *out, const gp_job_columns *columns)
 {
     memset(out, 0, sizeof *out);
     gp_store_new_job_id(out->id);
@@ -115,7 +115,8 @@ void gp_store_new_job(gp_job *out, const gp_spec *spec)
     snprintf(out->updated, sizeof out->updated, "%s", out->created);
     snprintf(out->message, sizeof out->message, "queued");
     out->status = GP_JOB_ACCEPTED;
-    out->has_mesh = spec->mesh_enabled;
+    out->has_mesh = columns->has_mesh;
+    snprintf(out->process, sizeof out->process, "%s", columns->process);
 }
 
 int gp_store_write_sections(const char *id, const gp_result *result,
@@ -219,10 +220,28 @@ int gp_store_recover(gp_db *db, int max_attempts, int *requeued, int *given_up)
     return db_ops(db)->recover(db, max_attempts, requeued, given_up);
 }
 
+void gp_job_columns_of_spec(const gp_spec *spec, gp_job_columns *out)
+{
+    *out = (gp_job_columns){"pack2d", spec->domain.width, spec->domain.height,
+                            gp_dist_kind_name(spec->dist.kind), gp_joint_law_name(spec->joint.law),
+                            (int)spec->level_band, spec->seed, spec->expected_disks,
+                            spec->mesh_enabled};
+}
+
+int gp_store_insert_job_columns(gp_db *db, const char *owner, size_t max_active,
+                                const char *spec_text, size_t spec_len,
+                                const gp_job_columns *columns, gp_job *out, long *active)
+{
+    return db_ops(db)->insert_job(db, owner, max_active, spec_text, spec_len, columns, out, active);
+}
+
 int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
                         size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
 {
-    return db_ops(db)->insert_job(db, owner, max_active, spec_text, spec_len, spec, out, active);
+    gp_job_columns columns;
+    gp_job_columns_of_spec(spec, &columns);
+    return gp_store_insert_job_columns(db, owner, max_active, spec_text, spec_len, &columns, out,
+                                       active);
 }
 
 int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out)
@@ -247,9 +266,33 @@ int gp_store_progress(gp_db *db, const char *id, int percent, const char *messag
     return db_ops(db)->progress(db, id, percent, message);
 }
 
+int gp_outcome_of_result(const gp_result *result, gp_section *sections, size_t *n,
+                         gp_outcome *out)
+{
+    const gp_packing *p = &result->packing;
+    int rc = gp_sections_from_result(result, sections, n);
+    *out = (gp_outcome){sections, rc ? 0 : *n, &result->stats, p->initial_front, p->attempts,
+                        p->closures, p->frozen, p->capped, p->max_level, "disks",
+                        result->timings, result->ntimings};
+    return rc;
+}
+
+int gp_store_finish_outcome(gp_db *db, const char *id, const gp_outcome *outcome)
+{
+    return db_ops(db)->finish(db, id, outcome);
+}
+
 int gp_store_finish(gp_db *db, const char *id, const gp_result *result)
 {
-    return db_ops(db)->finish(db, id, result);
+    gp_section sections[GP_SECTIONS_MAX];
+    size_t n = 0;
+    gp_outcome outcome;
+    int rc = gp_outcome_of_result(result, sections, &n, &outcome);
+    if (rc)
+        return rc;
+    rc = gp_store_finish_outcome(db, id, &outcome);
+    gp_sections_free(sections, n);
+    return rc;
 }
 
 int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message)

@@ -16,6 +16,7 @@
 
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
+#include "sections.h"
 
 /* Service error codes, next to the engine's GP_E... codes (all negative). */
 enum {
@@ -63,6 +64,8 @@ typedef struct gp_job {
     int progress; /* 0-100 */
     char message[256];
     int has_mesh; /* the spec asks for a mesh: the job's results include msh and inp */
+    char process[16]; /* the process the spec is for: "pack3d" when its domain has a depth,
+                         else "pack2d" (read from the stored spec, as processes.c tells it) */
 } gp_job;
 
 typedef struct gp_store gp_store;
@@ -159,6 +162,27 @@ void gp_store_release(gp_store *store, gp_db *db);
 int gp_store_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
                         size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
 
+/* What a job's row keeps of its spec, in columns (for people querying the database): its
+ * process fills it (server/processes.h). The strings are static names. */
+typedef struct gp_job_columns {
+    const char *process;      /* its id, "pack2d" or "pack3d" (not stored: the spec tells it) */
+    double width, height;     /* the domain's first two sides (a 3D box's depth is in the spec) */
+    const char *distribution; /* the law's kind */
+    const char *joint;        /* the joint law */
+    int level_band;
+    uint64_t seed;
+    double expected;          /* grains expected (disks or spheres) */
+    int has_mesh;             /* the job's results include msh and inp */
+} gp_job_columns;
+
+/* The columns of a 2D spec. */
+void gp_job_columns_of_spec(const gp_spec *spec, gp_job_columns *out);
+
+/* gp_store_insert_job for any process: the summary columns given as they are. */
+int gp_store_insert_job_columns(gp_db *db, const char *owner, size_t max_active,
+                                const char *spec_text, size_t spec_len,
+                                const gp_job_columns *columns, gp_job *out, long *active);
+
 /* Reads a job's status. Returns 0, GP_SRV_ENOTFOUND or GP_SRV_EDB. */
 int gp_store_get_job(gp_db *db, const char *id, const char *owner, gp_job *out);
 
@@ -187,6 +211,29 @@ int gp_store_progress(gp_db *db, const char *id, int percent, const char *messag
  * nothing is written) or GP_SRV_EDB. */
 int gp_store_finish(gp_db *db, const char *id, const gp_result *result);
 
+/* What any process's successful run leaves in the store, borrowed for the call: its
+ * sections (core/sections.h), the statistics of its grains against the law (the columns
+ * and the per-bin rows), the front's counters (columns; 0 where the process has none),
+ * the noun of its grains for the job's message ("disks", "spheres") and its timings. */
+typedef struct gp_outcome {
+    const gp_section *sections;
+    size_t nsections;
+    const gp_pack_stats *stats;
+    uint64_t initial_front, attempts, closures, frozen, capped;
+    uint32_t max_level;
+    const char *noun;
+    const gp_stage_time *timings;
+    int ntimings;
+} gp_outcome;
+
+/* gp_store_finish for any process: the outcome as given. */
+int gp_store_finish_outcome(gp_db *db, const char *id, const gp_outcome *outcome);
+
+/* The outcome of a 2D result: its sections cut into sections[GP_SECTIONS_MAX] (*n of them,
+ * borrowing from `result`; free with gp_sections_free). Returns 0 or gp_sections_from_result's code. */
+int gp_outcome_of_result(const gp_result *result, gp_section *sections, size_t *n,
+                         gp_outcome *out);
+
 /* Marks a running job failed with a reason. Returns 0, GP_SRV_ESTATE or GP_SRV_EDB. */
 int gp_store_fail(gp_db *db, const char *id, const char *code_name, const char *message);
 
@@ -207,7 +254,11 @@ typedef struct gp_stored_result {
     int64_t key;            /* the store's own handle of the result, for gp_result_reader */
     char *spec_text;        /* owned, NUL-terminated: the spec as submitted */
     size_t spec_len;
-    gp_result summary;      /* owned (gp_result_free): per-grain arrays NULL */
+    gp_result summary;      /* owned (gp_result_free): per-grain arrays NULL; a 2D result's
+                               summary, zero for another process's */
+    gp_section raw[GP_SECTIONS_MAX]; /* the summary sections as stored (bytes owned), for
+                                        a process that decodes its own (processes.h) */
+    size_t nraw;
     char version[40];       /* changes whenever the stored bytes could (a strong ETag's root) */
 } gp_stored_result;
 

@@ -91,14 +91,14 @@ void gp_db_bind_owner(sqlite3_stmt *s, int i, const char *owner);
  * the contract of its gp_store_ namesake in store.h or of its entry in store_ops.h. */
 int sq_recover(gp_db *db, int max_attempts, int *requeued, int *given_up);
 int sq_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
-                  size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
+                  size_t spec_len, const gp_job_columns *columns, gp_job *out, long *active);
 int sq_get_job(gp_db *db, const char *id, const char *owner, gp_job *out);
 int sq_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
                  size_t limit, gp_job *out, size_t *n, int *more);
 int sq_claim(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
              size_t *spec_len);
 int sq_progress(gp_db *db, const char *id, int percent, const char *message);
-int sq_finish(gp_db *db, const char *id, const gp_result *result);
+int sq_finish(gp_db *db, const char *id, const gp_outcome *outcome);
 int sq_fail(gp_db *db, const char *id, const char *code_name, const char *message);
 int sq_requeue(gp_db *db, const char *id);
 int sq_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,

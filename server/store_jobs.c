@@ -27,6 +27,7 @@ static void read_job(sqlite3_stmt *s, gp_job *job)
     job->progress = sqlite3_column_int(s, 7);
     gp_db_copy_text(job->message, sizeof job->message, s, 8);
     job->has_mesh = sqlite3_column_int(s, 9);
+    gp_db_copy_text(job->process, sizeof job->process, s, 10);
 }
 
 /* The owner's accepted and running jobs; inside the inserting transaction. */
@@ -43,12 +44,12 @@ static int count_active(gp_db *db, const char *owner, long *active)
 }
 
 int sq_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
-                        size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
+                        size_t spec_len, const gp_job_columns *columns, gp_job *out, long *active)
 {
     long n_active = 0;
     if (active)
         *active = 0;
-    gp_store_new_job(out, spec);
+    gp_store_new_job(out, columns);
     int rc;
     sqlite3_stmt *s = gp_db_write(db, ST_INSERT, &rc);
     if (!s)
@@ -66,13 +67,13 @@ int sq_insert_job(gp_db *db, const char *owner, size_t max_active, const char *s
     sqlite3_bind_text(s, 1, out->id, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 2, out->created, -1, SQLITE_STATIC);
     sqlite3_bind_text(s, 3, spec_text, (int)spec_len, SQLITE_STATIC);
-    sqlite3_bind_double(s, 4, spec->domain.width);
-    sqlite3_bind_double(s, 5, spec->domain.height);
-    sqlite3_bind_text(s, 6, gp_dist_kind_name(spec->dist.kind), -1, SQLITE_STATIC);
-    sqlite3_bind_text(s, 7, gp_joint_law_name(spec->joint.law), -1, SQLITE_STATIC);
-    sqlite3_bind_int(s, 8, (int)spec->level_band);
-    sqlite3_bind_int64(s, 9, (sqlite3_int64)spec->seed);
-    sqlite3_bind_double(s, 10, spec->expected_disks);
+    sqlite3_bind_double(s, 4, columns->width);
+    sqlite3_bind_double(s, 5, columns->height);
+    sqlite3_bind_text(s, 6, columns->distribution, -1, SQLITE_STATIC);
+    sqlite3_bind_text(s, 7, columns->joint, -1, SQLITE_STATIC);
+    sqlite3_bind_int(s, 8, columns->level_band);
+    sqlite3_bind_int64(s, 9, (sqlite3_int64)columns->seed);
+    sqlite3_bind_double(s, 10, columns->expected);
     sqlite3_bind_text(s, 11, owner, -1, SQLITE_STATIC);
     if (sqlite3_step(s) == SQLITE_ROW)
         out->seq = sqlite3_column_int64(s, 0);

@@ -33,14 +33,14 @@ struct gp_store_ops {
     void (*release)(gp_store *store, gp_db *db);
     int (*recover)(gp_db *db, int max_attempts, int *requeued, int *given_up);
     int (*insert_job)(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
-                      size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
+                      size_t spec_len, const gp_job_columns *columns, gp_job *out, long *active);
     int (*get_job)(gp_db *db, const char *id, const char *owner, gp_job *out);
     int (*list_jobs)(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
                      size_t limit, gp_job *out, size_t *n, int *more);
     int (*claim)(gp_db *db, atomic_long *queued, char id[GP_JOB_ID_SIZE], char **spec_text,
                  size_t *spec_len);
     int (*progress)(gp_db *db, const char *id, int percent, const char *message);
-    int (*finish)(gp_db *db, const char *id, const gp_result *result);
+    int (*finish)(gp_db *db, const char *id, const gp_outcome *outcome);
     int (*fail)(gp_db *db, const char *id, const char *code_name, const char *message);
     int (*requeue)(gp_db *db, const char *id);
     int (*dismiss)(gp_db *db, const char *id, const char *owner, gp_job_status *before,
@@ -74,11 +74,12 @@ int gp_store_sqlite_open(const char *path, gp_store **out, char *why, size_t why
 int gp_store_pg_open(const char *uri, gp_store **out, char *why, size_t why_size);
 
 /* Decodes the summary sections refs[0..n) of job `id` (read whole through read_chunk)
- * into *summary. Returns 0, GP_SRV_ENOTFOUND (a section is missing or has no packing: the
- * job was deleted meanwhile), GP_SRV_EDB (a section that cannot be decoded: logged) or
+ * into res->summary (a 2D result's; other tags are skipped) and keeps each as stored in
+ * res->raw. Returns 0, GP_SRV_ENOTFOUND (a section is missing, or none: the job was
+ * deleted meanwhile), GP_SRV_EDB (a section that cannot be decoded: logged) or
  * GP_ENOMEM. */
 int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *refs, size_t n,
-                            gp_result *summary);
+                            gp_stored_result *res);
 
 /* The connections a store has open (each backend's own type, as void *): closed with it. */
 typedef struct gp_store_conns {
@@ -92,7 +93,7 @@ int gp_store_conns_add(gp_store_conns *c, void *db);
 void gp_store_conns_remove(gp_store_conns *c, void *db);
 
 /* A new accepted job's fields (id, times, message, status, has_mesh), before its insert. */
-void gp_store_new_job(gp_job *out, const gp_spec *spec);
+void gp_store_new_job(gp_job *out, const gp_job_columns *columns);
 
 /* Cuts a successful job's result into sections (core/sections.h) and writes each with
  * write(ctx, id, section), stopping at the first failure. Returns 0, GP_ENOMEM or what

@@ -99,7 +99,7 @@ int gp_pg_reap(pg_db *db, int max_attempts, int *requeued, int *given_up);
 /* The functions behind gp_store_pg_ops, each with the contract of its gp_store_
  * namesake in store.h or of its entry in store_ops.h. */
 int gp_pg_insert_job(gp_db *db, const char *owner, size_t max_active, const char *spec_text,
-                     size_t spec_len, const gp_spec *spec, gp_job *out, long *active);
+                     size_t spec_len, const gp_job_columns *columns, gp_job *out, long *active);
 int gp_pg_get_job(gp_db *db, const char *id, const char *owner, gp_job *out);
 int gp_pg_list_jobs(gp_db *db, const char *owner, unsigned status_mask, int64_t before,
                     size_t limit, gp_job *out, size_t *n, int *more);
@@ -111,7 +111,7 @@ int gp_pg_requeue(gp_db *db, const char *id);
 int gp_pg_dismiss(gp_db *db, const char *id, const char *owner, gp_job_status *before,
                   int *deleted, gp_job *after);
 int gp_pg_count(gp_db *db, long counts[GP_JOB_NSTATUS]);
-int gp_pg_finish(gp_db *db, const char *id, const gp_result *result);
+int gp_pg_finish(gp_db *db, const char *id, const gp_outcome *outcome);
 int gp_pg_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out);
 int gp_pg_find_section(gp_db *db, int64_t key, const char *tag, int64_t *section,
                        uint64_t *bytes);

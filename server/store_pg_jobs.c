@@ -10,7 +10,10 @@
 
 #include "log.h"
 
-#define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message, has_mesh"
+/* process: "pack3d" when the spec's domain has a depth (gp_process_of_spec, processes.h) */
+#define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message," \
+                    " has_mesh, CASE WHEN coalesce(spec::jsonb #> '{inputs,domain,depth}'," \
+                    " spec::jsonb #> '{domain,depth}') IS NULL THEN 'pack2d' ELSE 'pack3d' END"
 
 /* The owner advisory lock's class (pg_advisory_xact_lock(int, int)): "gp" */
 #define OWNER_LOCK_CLASS 0x6770
@@ -37,15 +40,16 @@ static void read_job(const PGresult *res, int row, gp_job *job)
     job->progress = atoi(PQgetvalue(res, row, 7));
     copy_text(job->message, sizeof job->message, res, row, 8);
     job->has_mesh = PQgetvalue(res, row, 9)[0] == 't';
+    copy_text(job->process, sizeof job->process, res, row, 10);
 }
 
 int gp_pg_insert_job(gp_db *d, const char *owner, size_t max_active, const char *spec_text,
-                     size_t spec_len, const gp_spec *spec, gp_job *out, long *active)
+                     size_t spec_len, const gp_job_columns *columns, gp_job *out, long *active)
 {
     pg_db *db = gp_pg_db(d);
     if (active)
         *active = 0;
-    gp_store_new_job(out, spec);
+    gp_store_new_job(out, columns);
     char *text = strndup(spec_text, spec_len);
     if (!text)
         return GP_ENOMEM;
@@ -76,15 +80,15 @@ int gp_pg_insert_job(gp_db *d, const char *owner, size_t max_active, const char 
         gp_pg_text(&p, out->id);
         gp_pg_text(&p, out->created);
         gp_pg_text(&p, text);
-        gp_pg_double(&p, b[0], spec->domain.width);
-        gp_pg_double(&p, b[1], spec->domain.height);
-        gp_pg_text(&p, gp_dist_kind_name(spec->dist.kind));
-        gp_pg_text(&p, gp_joint_law_name(spec->joint.law));
-        gp_pg_int(&p, b[2], (long long)spec->level_band);
-        gp_pg_int(&p, b[3], (long long)spec->seed);
-        gp_pg_double(&p, b[4], spec->expected_disks);
+        gp_pg_double(&p, b[0], columns->width);
+        gp_pg_double(&p, b[1], columns->height);
+        gp_pg_text(&p, columns->distribution);
+        gp_pg_text(&p, columns->joint);
+        gp_pg_int(&p, b[2], (long long)columns->level_band);
+        gp_pg_int(&p, b[3], (long long)columns->seed);
+        gp_pg_double(&p, b[4], columns->expected);
         gp_pg_text(&p, owner);
-        gp_pg_text(&p, spec->mesh_enabled ? "true" : "false");
+        gp_pg_text(&p, columns->has_mesh ? "true" : "false");
         PGresult *res = gp_pg_query(
             db, "insert job",
             "INSERT INTO jobs (id, status, created, updated, message, spec, domain_width,"

@@ -47,10 +47,12 @@ static int write_section(void *ctx, const char *id, const gp_section *sec)
 }
 
 /* The result rows of a successful job: its sections, bins and timings. */
-static int write_result_rows(pg_db *db, const char *id, const gp_result *result)
+static int write_result_rows(pg_db *db, const char *id, const gp_outcome *result)
 {
-    int rc = gp_store_write_sections(id, result, write_section, db);
-    const gp_pack_stats *st = &result->stats;
+    int rc = 0;
+    for (size_t i = 0; rc == 0 && i < result->nsections; i++)
+        rc = write_section(db, id, &result->sections[i]);
+    const gp_pack_stats *st = result->stats;
     for (size_t i = 0; rc == 0 && i < st->nbins; i++) {
         const gp_bin_stat *bin = &st->bins[i];
         char b[7][32];
@@ -83,16 +85,16 @@ static int write_result_rows(pg_db *db, const char *id, const gp_result *result)
     return rc;
 }
 
-int gp_pg_finish(gp_db *d, const char *id, const gp_result *result)
+int gp_pg_finish(gp_db *d, const char *id, const gp_outcome *result)
 {
     pg_db *db = gp_pg_db(d);
     pg_store *store = gp_pg_store(db->store);
-    const gp_pack_stats *st = &result->stats;
-    const gp_packing *pk = &result->packing;
+    const gp_pack_stats *st = result->stats;
+    const gp_outcome *pk = result;
     char now[GP_TIMESTAMP_SIZE], message[128], version[33], b[20][32];
     gp_timestamp_now(now);
     gp_store_new_result_version(version);
-    snprintf(message, sizeof message, "%zu disks, packing density %.4f", st->count,
+    snprintf(message, sizeof message, "%zu %s, packing density %.4f", st->count, pk->noun,
              st->packing_density);
     pg_params p = {0};
     gp_pg_text(&p, id);
@@ -162,7 +164,7 @@ static int open_summary(pg_db *db, const char *id, gp_stored_result *res)
         found[n].bytes = (uint64_t)atoll(PQgetvalue(r, row, 3));
     }
     PQclear(r);
-    return gp_store_decode_summary((gp_db *)(void *)db, id, found, n, &res->summary);
+    return gp_store_decode_summary((gp_db *)(void *)db, id, found, n, res);
 }
 
 int gp_pg_open_result(gp_db *d, const char *id, const char *owner, gp_stored_result *out)

@@ -38,32 +38,43 @@ static int read_whole(gp_db *db, const gp_section_ref *ref, unsigned char **out)
 }
 
 int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *refs, size_t n,
-                            gp_result *summary)
+                            gp_stored_result *res)
 {
-    int have_pack = 0;
-    for (size_t i = 0; i < n; i++) {
+    /* every process's result has summary sections: none means no result */
+    if (n == 0)
+        return GP_SRV_ENOTFOUND;
+    for (size_t i = 0; i < n && i < GP_SECTIONS_MAX; i++) {
         unsigned char *bytes = NULL;
         int rc = read_whole(db, &refs[i], &bytes);
         if (rc == 0)
             rc = gp_section_decode_summary(refs[i].tag, refs[i].version, bytes,
-                                           (size_t)refs[i].bytes, summary);
-        free(bytes);
+                                           (size_t)refs[i].bytes, &res->summary);
         if (rc == GP_EPARSE || rc == GP_EINVAL) {
+            free(bytes);
             gp_log("store: job %s: its result section %s (version %u) cannot be decoded", id,
                    refs[i].tag, refs[i].version);
             return GP_SRV_EDB;
         }
-        if (rc)
+        if (rc) {
+            free(bytes);
             return rc;
-        have_pack |= strcmp(refs[i].tag, GP_SECTION_PACK) == 0;
+        }
+        /* kept as stored, for a process that decodes its own summary (processes.h) */
+        gp_section *raw = &res->raw[res->nraw++];
+        snprintf(raw->tag, sizeof raw->tag, "%s", refs[i].tag);
+        raw->version = refs[i].version;
+        raw->summary = 1;
+        raw->data = raw->owned = bytes;
+        raw->size = (size_t)refs[i].bytes;
     }
-    return have_pack ? 0 : GP_SRV_ENOTFOUND;
+    return 0;
 }
 
 void gp_stored_result_free(gp_stored_result *r)
 {
     free(r->spec_text);
     gp_result_free(&r->summary);
+    gp_sections_free(r->raw, r->nraw);
     memset(r, 0, sizeof *r);
 }
 

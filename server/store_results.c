@@ -55,11 +55,13 @@ int gp_db_write_sections(gp_db *db, const char *id, const gp_result *result)
 }
 
 /* The result rows of a successful job; called inside the finishing transaction. */
-static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
+static int write_result_rows(gp_db *db, const char *id, const gp_outcome *result)
 {
-    const gp_pack_stats *st = &result->stats;
+    const gp_pack_stats *st = result->stats;
     sqlite3_stmt *s;
-    int rc = gp_db_write_sections(db, id, result);
+    int rc = 0;
+    for (size_t i = 0; rc == 0 && i < result->nsections; i++)
+        rc = write_section(db, id, &result->sections[i]);
     for (size_t i = 0; rc == 0 && i < st->nbins; i++) {
         const gp_bin_stat *b = &st->bins[i];
         if (!(s = gp_db_stmt(db, ST_BIN)))
@@ -86,13 +88,13 @@ static int write_result_rows(gp_db *db, const char *id, const gp_result *result)
     return rc;
 }
 
-int sq_finish(gp_db *db, const char *id, const gp_result *result)
+int sq_finish(gp_db *db, const char *id, const gp_outcome *result)
 {
-    const gp_pack_stats *st = &result->stats;
-    const gp_packing *p = &result->packing;
+    const gp_pack_stats *st = result->stats;
+    const gp_outcome *p = result;
     char now[GP_TIMESTAMP_SIZE], message[128];
     gp_timestamp_now(now);
-    snprintf(message, sizeof message, "%zu disks, packing density %.4f", st->count,
+    snprintf(message, sizeof message, "%zu %s, packing density %.4f", st->count, p->noun,
              st->packing_density);
     int rc;
     sqlite3_stmt *s = gp_db_write(db, ST_FINISH, &rc);
@@ -146,7 +148,7 @@ static int open_summary(gp_db *db, const char *id, gp_stored_result *res)
     sqlite3_reset(s);
     if (rc != SQLITE_ROW && rc != SQLITE_DONE)
         return gp_db_fail(db, "list result sections");
-    return gp_store_decode_summary(db, id, found, n, &res->summary);
+    return gp_store_decode_summary(db, id, found, n, res);
 }
 
 int sq_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out)

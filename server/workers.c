@@ -16,9 +16,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "grainpack/pipeline.h"
-#include "grainpack/spec.h"
 #include "log.h"
+#include "processes.h"
 
 /* Seconds between two progress writes of one job: often enough for a person watching a
  * long job, rare enough that progress never competes with submissions for the write lock. */
@@ -98,7 +97,7 @@ typedef struct worker {
     gp_db *db;                   /* its own connection, for the thread's lifetime */
     double last_write;           /* progress throttling */
     int last_percent;
-    const char *stages[4];       /* the stages of the job (plan_stages) */
+    const char *stages[GP_PROCESS_MAX_STAGES]; /* the stages of the job (its process's) */
     int nstages;
 } worker;
 
@@ -161,19 +160,6 @@ static void test_stall(worker *w, const char *id)
     struct timespec ts = {(time_t)pool->stall, (long)((pool->stall - (double)(time_t)pool->stall) * 1e9)};
     while (nanosleep(&ts, &ts) != 0)
         ;
-}
-
-/* The stages the spec runs, in order, for report_progress. */
-static void plan_stages(worker *w, const gp_spec *spec)
-{
-    w->nstages = 0;
-    w->stages[w->nstages++] = "pack";
-    if (spec->balance_enabled || spec->laguerre_enabled)
-        w->stages[w->nstages++] = "triangulation";
-    if (spec->balance_enabled)
-        w->stages[w->nstages++] = "balance";
-    if (spec->laguerre_enabled)
-        w->stages[w->nstages++] = "laguerre";
 }
 
 /* Seconds the thread tid has waited for a processor since it started (the second field
@@ -388,17 +374,17 @@ static void *watchdog_main(void *arg)
 /* What a run of a job came to, for the store. */
 typedef enum outcome_kind { OUTCOME_FINISH, OUTCOME_FAIL } outcome_kind;
 
-static int store_outcome(worker *w, const char *id, outcome_kind kind, const gp_result *result,
+static int store_outcome(worker *w, const char *id, outcome_kind kind, const gp_outcome *result,
                          const char *code, const char *message)
 {
     if (kind == OUTCOME_FINISH)
-        return gp_store_finish(w->db, id, result);
+        return gp_store_finish_outcome(w->db, id, result);
     return gp_store_fail(w->db, id, code, message);
 }
 
 /* Stores the outcome, trying again while the store cannot write it (see
  * STORE_RETRY_FIRST) until it can or the pool stops. Returns the last store result. */
-static int persist(worker *w, const char *id, outcome_kind kind, const gp_result *result,
+static int persist(worker *w, const char *id, outcome_kind kind, const gp_outcome *result,
                    const char *code, const char *message)
 {
     gp_pool *pool = w->pool;
@@ -440,20 +426,24 @@ static int persist(worker *w, const char *id, outcome_kind kind, const gp_result
 }
 
 /* Records how a run ended, in the store, the metrics and the log. */
-static void conclude(worker *w, const char *id, int rc, const gp_result *result,
+static void conclude(worker *w, const char *id, int rc, const gp_process_run *run,
                      const gp_error *err)
 {
     gp_service *svc = w->pool->svc;
     int flag = atomic_load(&w->cancel);
     if (rc == 0) {
-        for (int i = 0; i < result->ntimings; i++)
+        const gp_outcome *result = &run->outcome;
+        double pack = 0.0;
+        for (int i = 0; i < result->ntimings; i++) {
             gp_metrics_stage(svc->metrics, result->timings[i].stage, result->timings[i].seconds);
+            if (strcmp(result->timings[i].stage, "pack") == 0)
+                pack = result->timings[i].seconds;
+        }
         int st = persist(w, id, OUTCOME_FINISH, result, NULL, NULL);
         if (st == 0) {
             gp_metrics_outcome(svc->metrics, "successful");
-            gp_log("job %s successful: %zu disks, packing density %.4f, %.3f s", id,
-                   result->stats.count, result->stats.packing_density,
-                   gp_result_stage_seconds(result, "pack"));
+            gp_log("job %s successful: %zu %s, packing density %.4f, %.3f s", id, run->count,
+                   result->noun, run->density, pack);
         } else if (st == GP_SRV_ESTATE) {
             gp_metrics_outcome(svc->metrics, "discarded");
             gp_log("job %s finished after it was dismissed: result discarded", id);
@@ -491,23 +481,22 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
     w->last_write = gp_monotonic_seconds();
 
     /* the stored spec was valid when accepted; it is parsed again without the caps, which
-     * may have been lowered since, so that an accepted job always runs */
+     * may have been lowered since, so that an accepted job always runs; its process is
+     * the one the text is for */
+    const gp_process_def *process = gp_process_of_spec(spec_text, spec_len);
     gp_spec_limits unlimited = {(size_t)-1, (size_t)-1, (size_t)-1};
-    gp_spec spec;
-    gp_result result;
+    void *spec = NULL;
+    gp_process_run result;
     gp_error err;
     gp_error_clear(&err);
     memset(&result, 0, sizeof result);
-    int rc = gp_spec_parse(spec_text, spec_len, &unlimited, &spec, &err);
+    int rc = process->parse(spec_text, spec_len, &unlimited, &spec, &err);
     if (rc == 0) {
         test_stall(w, id);
-        plan_stages(w, &spec);
-        /* a mesh stops when it grows far beyond today's cap (the estimate it was accepted
-           on may be off; gp_spec.max_elements) */
-        spec.max_elements = svc->cfg->max_elements;
+        w->nstages = process->stages(spec, w->stages, GP_PROCESS_MAX_STAGES);
         gp_progress progress = {report_progress, w, &w->cancel};
         gp_metrics_pipeline_run(svc->metrics);
-        rc = gp_pipeline_run(&spec, svc->cfg->max_disks, &progress, &result, &err);
+        rc = process->run(spec, svc->cfg, &progress, &result, &err);
     }
     pthread_mutex_lock(&w->pool->lock);
     /* a worker given up on had its job recorded then (failed, or dismissed already): what
@@ -520,8 +509,10 @@ static void run_job(worker *w, const char *id, const char *spec_text, size_t spe
                gp_monotonic_seconds() - w->started);
     else
         conclude(w, id, rc, &result, &err);
-    gp_result_free(&result);
-    gp_spec_free(&spec);
+    if (rc == 0)
+        process->free_run(&result);
+    if (spec)
+        process->free_spec(spec);
     if (!abandoned) {
         int was_last = atomic_fetch_sub(&w->pool->busy, 1) == 1;
         set_current(w, "");

@@ -2,10 +2,13 @@
  * to the same statistics, and every writer gives the very bytes of the result in memory
  * when it reads the per-grain arrays from the sections window by window (windows of a few
  * grains, so that every cell boundary falls on one), and when it is stopped and resumed
- * every few bytes. Corrupt or truncated sections are refused, not read past. */
+ * every few bytes. Corrupt or truncated sections are refused, not read past. A 3D
+ * packing's sections read back the same way. */
+#include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
+#include "grainpack/pipeline3d.h"
 #include "json_values.h"
 #include "sections.h"
 #include "packing_checks.h"
@@ -311,8 +314,66 @@ static void test_pack_section_keeps_the_front_rule(void)
     }
 }
 
+/* A 3D packing's sections: the summary decodes to the box, the front's counters and the
+ * statistics bit for bit, the spheres section is the spheres as placed, every truncation
+ * of the summary is refused, another version is not read, and a 2D reader skips both. */
+static void test_pack3d_sections(void)
+{
+    gp_spec3d spec;
+    gp_error err;
+    const char *text = "{\"inputs\": {\"domain\": {\"width\": 9, \"height\": 7, \"depth\": 6},"
+                       " \"distribution\": {\"kind\": \"uniform\", \"min\": 0.4, \"max\": 0.9},"
+                       " \"joint\": {\"law\": \"constant\", \"value\": 0.05}, \"seed\": 4}}";
+    CHECK_MSG(gp_spec3d_parse(text, strlen(text), NULL, &spec, &err) == 0, "%s", err.message);
+    gp_pack3d_params params = gp_spec3d_pack_params(&spec, 0);
+    gp_packing3d p;
+    CHECK_MSG(gp_pack3d(&params, NULL, &p, &err) == 0, "%s", err.message);
+    gp_pack3d_stats st;
+    CHECK(gp_pack3d_stats_compute(&spec.box, &spec.dist, &p, &st) == 0);
+    double volume = spec.box.width * spec.box.height * spec.box.depth;
+    CHECK(st.count == p.count && p.count > 50 && st.box_volume == volume);
+    CHECK_MSG(fabs(st.packing_density - p.fill_volume / volume) < 1e-12 * st.packing_density,
+              "density %.17g, fill %.17g", st.packing_density, p.fill_volume / volume);
+    size_t binned = 0;
+    for (size_t i = 0; i < st.nbins; i++)
+        binned += st.bins[i].count;
+    CHECK(binned == p.count && st.dof == (int)st.nbins - 1 && st.p_value > 0 && st.p_value <= 1);
+
+    gp_section sec[GP_SECTIONS_MAX];
+    size_t n;
+    CHECK(gp_sections_from_packing3d(&spec.box, &p, &st, sec, &n) == 0 && n == 2);
+    CHECK(strcmp(sec[0].tag, GP_SECTION_PACK3D) == 0 && sec[0].summary);
+    CHECK(strcmp(sec[1].tag, GP_SECTION_SPHERES) == 0 && !sec[1].summary &&
+          sec[1].size == p.count * 40 && memcmp(sec[1].data, p.spheres, sec[1].size) == 0);
+    gp_summary3d sum;
+    CHECK(gp_section_decode_summary3d(sec[0].tag, sec[0].version, sec[0].data, sec[0].size, &sum) == 0);
+    CHECK(memcmp(&sum.box, &spec.box, sizeof sum.box) == 0 && sum.packing.count == p.count &&
+          sum.packing.wall_spheres == p.wall_spheres && sum.packing.triangles == p.triangles &&
+          sum.packing.attempts == p.attempts && sum.packing.max_level == p.max_level &&
+          sum.packing.fill_volume == p.fill_volume && !sum.packing.spheres);
+    CHECK(sum.stats.nbins == st.nbins && memcmp(sum.stats.bins, st.bins, st.nbins * sizeof *st.bins) == 0);
+    CHECK(sum.stats.packing_density == st.packing_density && sum.stats.chi2 == st.chi2 &&
+          sum.stats.r_min == st.r_min && sum.stats.joint_max == st.joint_max);
+    gp_summary3d_free(&sum);
+    size_t refused = 0, cuts = 0;
+    for (size_t cut = 0; cut < sec[0].size; cut++, cuts++)
+        refused += gp_section_decode_summary3d(sec[0].tag, sec[0].version, sec[0].data, cut, &sum) == GP_EPARSE;
+    CHECK_MSG(refused == cuts, "%zu of %zu truncations refused", refused, cuts);
+    CHECK(gp_section_decode_summary3d(sec[0].tag, sec[0].version + 1, sec[0].data, sec[0].size, &sum) == GP_EINVAL);
+    gp_result summary;
+    memset(&summary, 0, sizeof summary);
+    for (size_t i = 0; i < n; i++)
+        CHECK(gp_section_decode_summary(sec[i].tag, sec[i].version, sec[i].data, sec[i].size, &summary) == 0);
+    CHECK(summary.packing.count == 0);
+    gp_sections_free(sec, n);
+    gp_pack3d_stats_free(&st);
+    gp_packing3d_free(&p);
+    gp_spec3d_free(&spec);
+}
+
 int main(void)
 {
+    RUN(test_pack3d_sections);
     RUN(test_every_format_reads_the_same_from_sections);
     RUN(test_mesh_from_sections);
     RUN(test_corrupt_sections_are_refused);

@@ -18,6 +18,7 @@
 
 #include "check.h"
 #include "grainpack/spec.h"
+#include "grainpack/pipeline3d.h"
 #include "log.h"
 #include "sections.h"
 #include "store.h"
@@ -159,6 +160,69 @@ static void test_jobs_are_claimed_oldest_first_and_results_read_back_whole(void)
     CHECK(gp_store_healthy(db));
     gp_result_free(&r);
     gp_spec_free(&spec);
+    gp_store_release(store, db);
+    gp_store_close(store);
+}
+
+/* Any process's outcome: a pack3d run (sections "pack3d" and "spheres", its statistics)
+ * is stored as given, its job reads back as pack3d (the process the stored spec is for),
+ * its message counts spheres, its summary section comes back as stored and its spheres
+ * byte for byte, its bins and timings are rows like 2D's. */
+static void test_a_pack3d_outcome_is_stored_and_read_back(void)
+{
+    static const char text[] = "{\"inputs\": {\"domain\": {\"width\": 6, \"height\": 6,"
+                               " \"depth\": 6}, \"distribution\": {\"kind\": \"constant\","
+                               " \"radius\": 0.5}, \"seed\": 2}}";
+    new_database();
+    gp_store *store = open_store();
+    gp_db *db = gp_store_acquire(store, 1);
+    gp_spec3d spec;
+    gp_error err;
+    CHECK(gp_spec3d_parse(text, strlen(text), NULL, &spec, &err) == 0);
+    gp_pack3d_params params = gp_spec3d_pack_params(&spec, 0);
+    gp_packing3d p;
+    gp_pack3d_stats st;
+    CHECK(gp_pack3d(&params, NULL, &p, &err) == 0 && p.count > 20);
+    CHECK(gp_pack3d_stats_compute(&spec.box, &spec.dist, &p, &st) == 0);
+    gp_job_columns columns = {"pack3d", 6, 6, "constant", "none", 0, 2, spec.expected_spheres, 0};
+    gp_job job, got;
+    CHECK(gp_store_insert_job_columns(db, "", 0, text, strlen(text), &columns, &job, NULL) == 0);
+    CHECK(strcmp(job.process, "pack3d") == 0);
+    char id[GP_JOB_ID_SIZE];
+    claim_one(db, id);
+    gp_section sec[GP_SECTIONS_MAX];
+    size_t n;
+    CHECK(gp_sections_from_packing3d(&spec.box, &p, &st, sec, &n) == 0);
+    gp_stage_time timings[1] = {{"pack3d", 0.25}};
+    gp_pack_stats view = gp_pack3d_stats_view(&st);
+    gp_outcome outcome = {sec, n, &view, 0, p.attempts, 0, 0, 0, p.max_level, "spheres", timings, 1};
+    CHECK(gp_store_finish_outcome(db, id, &outcome) == 0);
+    CHECK(gp_store_get_job(db, id, NULL, &got) == 0 && got.status == GP_JOB_SUCCESSFUL &&
+          strcmp(got.process, "pack3d") == 0 && strstr(got.message, " spheres, packing density "));
+    gp_job list[2];
+    size_t listed;
+    int more;
+    CHECK(gp_store_list_jobs(db, NULL, 0, 0, 2, list, &listed, &more) == 0 && listed == 1 &&
+          strcmp(list[0].process, "pack3d") == 0);
+    gp_stored_result res;
+    CHECK(gp_store_open_result(db, id, NULL, &res) == 0 && res.nraw == 1 && res.summary.stats.count == 0);
+    CHECK(strcmp(res.raw[0].tag, GP_SECTION_PACK3D) == 0 && res.raw[0].size == sec[0].size &&
+          memcmp(res.raw[0].data, sec[0].data, sec[0].size) == 0);
+    gp_result_reader *reader = gp_result_reader_new(res.key);
+    size_t bytes = p.count * sizeof(gp_sphere);
+    unsigned char *back = malloc(bytes);
+    CHECK(gp_result_reader_read(reader, db, GP_SECTION_SPHERES, 0, back, bytes) == 0);
+    CHECK(memcmp(back, p.spheres, bytes) == 0);
+    free(back);
+    gp_result_reader_free(reader);
+    gp_stored_result_free(&res);
+    char names[2][32];
+    double seconds[2];
+    CHECK(gp_store_load_timings(db, id, names, seconds, 2) == 1 && strcmp(names[0], "pack3d") == 0);
+    gp_sections_free(sec, n);
+    gp_pack3d_stats_free(&st);
+    gp_packing3d_free(&p);
+    gp_spec3d_free(&spec);
     gp_store_release(store, db);
     gp_store_close(store);
 }
@@ -503,6 +567,7 @@ int main(int argc, char **argv)
     }
     RUN(test_a_location_is_logged_without_its_password);
     RUN(test_jobs_are_claimed_oldest_first_and_results_read_back_whole);
+    RUN(test_a_pack3d_outcome_is_stored_and_read_back);
     RUN(test_a_job_dismissed_while_it_runs_keeps_no_result);
     RUN(test_a_job_is_never_started_before_it_was_created);
     RUN(test_jobs_are_seen_by_their_owner_only);

@@ -131,8 +131,8 @@ class Client:
         headers = {"Content-Type": content_type} if content_type else {}
         return self.request("POST", path, body=data, headers=headers)
 
-    def submit(self, spec):
-        return self.post_json("/processes/pack2d/execution", spec)
+    def submit(self, spec, process="pack2d"):
+        return self.post_json(f"/processes/{process}/execution", spec)
 
     def wait_final(self, job_id, limit=JOB_LIMIT):
         """Long-polls GET /jobs/{id}?wait=.. until the job is finished; its statusInfo."""
@@ -249,21 +249,24 @@ class Daemon:
 
 def check_store(checks, daemon, what):
     """The database file is sound and holds no half-written result: integrity_check is
-    ok; every successful job has its summary and its disks (32 bytes each, as many as its
-    count, in chunks adding up to the section), its per-bin statistics and its stage
-    timings; no other job has a result, and no chunk is left of a deleted one. Returns the
-    {id: status} of every job."""
+    ok; every successful job has its summary and its grains (a pack2d job's disks, 32
+    bytes each, or a pack3d job's spheres, 40 bytes each, as many as its count, in chunks
+    adding up to the section), its per-bin statistics and its stage timings; no other job
+    has a result, and no chunk is left of a deleted one. Returns the {id: status} of every
+    job."""
     db = daemon.db()
     try:
         checks.check(db.execute("PRAGMA integrity_check").fetchone()[0] == "ok", f"{what}: integrity_check")
         bad = db.execute(
             "SELECT j.id, j.status, j.count, d.bytes,"
             " (SELECT sum(length(c.data)) FROM result_chunks c WHERE c.section = d.id)"
-            " FROM jobs j LEFT JOIN result_sections d ON d.job_id = j.id AND d.tag = 'disks'"
-            " WHERE (j.status = 'successful' AND (d.bytes IS NULL OR d.bytes != 32 * j.count"
+            " FROM jobs j LEFT JOIN result_sections d ON d.job_id = j.id AND d.tag IN ('disks', 'spheres')"
+            " WHERE (j.status = 'successful' AND (d.bytes IS NULL"
+            "   OR d.bytes != (CASE d.tag WHEN 'disks' THEN 32 ELSE 40 END) * j.count"
             "   OR (j.count > 0 AND (SELECT sum(length(c.data)) FROM result_chunks c"
             "                        WHERE c.section = d.id) != d.bytes)"
-            "   OR NOT EXISTS (SELECT 1 FROM result_sections p WHERE p.job_id = j.id AND p.tag = 'pack')"
+            "   OR NOT EXISTS (SELECT 1 FROM result_sections p WHERE p.job_id = j.id"
+            "                  AND p.tag = (CASE d.tag WHEN 'disks' THEN 'pack' ELSE 'pack3d' END))"
             "   OR NOT EXISTS (SELECT 1 FROM bin_stats b WHERE b.job_id = j.id)"
             "   OR NOT EXISTS (SELECT 1 FROM stage_timings t WHERE t.job_id = j.id)))"
             " OR (j.status != 'successful' AND EXISTS"

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """test_openapi_contract.py - openapi.yaml says what the validator says: the report's
 four examples match the JobSpec schema, the bad specs of test_service_errors.py that a
-JSON Schema can express are rejected by it, and the process description served at
-/processes/pack2d (server/process-pack2d.json) repeats the same input schemas.
+JSON Schema can express are rejected by it, and the process descriptions served at
+/processes/pack2d and /processes/pack3d (server/process-*.json) repeat the same input
+schemas (Inputs, Inputs3D).
 (The document itself is checked against the OpenAPI 3.1 schema by test_openapi_valid.)"""
 
 import json
@@ -48,19 +49,31 @@ def test(c):
         rejected += 1
     c.check(rejected >= 15, f"only {rejected} bad specs checked against the schema")
 
-    with open(os.path.join(gpd.ROOT, "server", "process-pack2d.json")) as f:
+    for process_id, schema in (("pack2d", "Inputs"), ("pack3d", "Inputs3D")):
+        check_process(c, api, process_id, schema)
+    # a spec is one process's: the 3D inputs match JobSpec, a 2D domain with a depth does not
+    box = {"inputs": {"domain": {"width": 10, "height": 10, "depth": 10},
+                      "distribution": {"kind": "constant", "radius": 1}, "seed": 2}}
+    c.check(not api.validate(spec_schema, box), "JobSpec refuses a pack3d spec")
+    box["inputs"]["balance"] = {}
+    c.check(api.validate(spec_schema, box), "JobSpec accepts a pack3d spec with a balance")
+
+
+def check_process(c, api, process_id, schema):
+    """The process description served at /processes/ID repeats the inputs' schema."""
+    with open(os.path.join(gpd.ROOT, "server", f"process-{process_id}.json")) as f:
         process = json.load(f)
     errors = api.validate(api.schema("Process"), process)
-    c.check(not errors, f"process-pack2d.json is not a Process: {errors[:2]}")
-    inputs = resolve(api, api.schema("Inputs"))
-    c.check(set(process["inputs"]) == set(inputs["properties"]), "process inputs differ from Inputs")
+    c.check(not errors, f"process-{process_id}.json is not a Process: {errors[:2]}")
+    c.check(process["id"] == process_id, f"process-{process_id}.json has id {process['id']}")
+    inputs = resolve(api, api.schema(schema))
+    c.check(set(process["inputs"]) == set(inputs["properties"]), f"{process_id} inputs differ from {schema}")
     for name, desc in process["inputs"].items():
         ours = resolve(api, desc["schema"])
         theirs = inputs["properties"].get(name)
-        c.check(ours == theirs, f"input {name}: process description {ours} vs openapi.yaml {theirs}")
+        c.check(ours == theirs, f"{process_id} input {name}: process description {ours} vs openapi.yaml {theirs}")
         required = name in inputs["required"]
-        c.check(desc["minOccurs"] == (1 if required else 0), f"input {name}: minOccurs")
-
+        c.check(desc["minOccurs"] == (1 if required else 0), f"{process_id} input {name}: minOccurs")
 
 if __name__ == "__main__":
     gpd.main(test)

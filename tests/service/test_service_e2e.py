@@ -27,7 +27,7 @@ def check_service_documents(c, api, client):
     conf = client.get("/conformance").json()["conformsTo"]
     c.check("http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/core" in conf, f"conformance {conf}")
     processes = client.get("/processes").json()["processes"]
-    c.check([p["id"] for p in processes] == ["pack2d"], f"processes {processes}")
+    c.check([p["id"] for p in processes] == ["pack2d", "pack3d"], f"processes {processes}")
     desc = client.get("/processes/pack2d").json()
     c.check(set(desc["inputs"]) == {"domain", "distribution", "joint", "front", "seed", "balance",
                                     "laguerre", "mesh", "picture"},

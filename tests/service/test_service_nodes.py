@@ -117,6 +117,18 @@ def test_batch_and_kill(c, binary, uri, keys, key_file, tmp):
             n = int(status["message"].split()[0])
             c.check(r.status == 200 and r.body.count(b"\n") == n + 1,
                     f"job {job}: its CSV from node B has {n} disks: {r.status}")
+        # a pack3d job (spheres in a box) in the shared store: its process read back from
+        # the stored spec, its spheres served by the other node
+        box = {"inputs": {"domain": {"width": 8, "height": 8, "depth": 8},
+                          "distribution": {"kind": "constant", "radius": 0.5}}}
+        job = clients[0].submit(box, "pack3d").json()["jobID"]
+        info = clients[1].wait_final(job)
+        r = clients[1].get(f"/jobs/{job}/results?f=csv")
+        n = int(info["message"].split()[0]) if info["status"] == "successful" else -1
+        c.check(info["processID"] == "pack3d" and r.status == 200 and
+                r.body.startswith(b"x,y,z,r,R\n") and r.body.count(b"\n") == n + 1,
+                f"a pack3d job through node B: {info['status']}, {info['processID']}, {r.status}")
+        ids.append(job)
         # a listing's next page, made by A, asked of B (the nodes share the cursors' keys)
         page = clients[0].get("/jobs?limit=5").json()
         nxt = [link["href"] for link in page["links"] if link["rel"] == "next"]

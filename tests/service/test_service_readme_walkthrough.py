@@ -48,7 +48,8 @@ def test(c, binary):
                          "<!doctype html>", '"valid":true,"expected_disks":',
                          "x,y,r,R", '"packing_density"', '"timings"', "\n304\n", '"status":"dismissed"', "\n404\n",
                          '"pointer":"/inputs/distribution/radius"', '"status":"ok"',
-                         'grainpack_jobs{status="successful",node="', "openapi: 3.1.0", "$MeshFormat\n4.1 0 8"]:
+                         'grainpack_jobs{status="successful",node="', "openapi: 3.1.0", "$MeshFormat\n4.1 0 8",
+                         '"processID":"pack3d"', "x,y,z,r,R\n", '"box_volume":1000']:
             c.check(expected in out, f"walk-through output lacks {expected!r}")
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:

@@ -72,9 +72,10 @@ check(tooLong.response.status === 400 && tooLong.error?.type === "urn:grainpack:
       `wait=${maxWait + 1}: ${tooLong.response.status} ${tooLong.error?.type}`);
 
 // the results, as JSON (typed) and as CSV (text)
-// (the operation has four media types: the JSON one is the object, the others text)
+// (the operation has four media types: the JSON one is the object, the others text; the
+// object is a pack2d Result, with disks, or a pack3d one, with spheres)
 const result = await client.GET("/jobs/{jobId}/results", { params: { path: { jobId }, query: { f: "json" } } });
-const json = typeof result.data === "object" ? result.data : undefined;
+const json = typeof result.data === "object" && "disks" in result.data ? result.data : undefined;
 const disks = json?.disks ?? [];
 const count = json?.statistics.count ?? -1;
 check(result.response.status === 200 && disks.length === count && count > 100, `results: ${count} disks`);
