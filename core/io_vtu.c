@@ -2,9 +2,10 @@
  * meshio read: the mesh with its cell data, or without a mesh the grains themselves
  * (cells as polygons, or disk centres as vertices). */
 #include <math.h>
+#include <stdlib.h>
 
 #include "grainpack/io_mesh.h"
-#include "writer.h"
+#include "io_mesh_plan.h"
 
 /* VTK cell types (vtkCellType.h). */
 #define VTK_VERTEX 1
@@ -91,53 +92,6 @@ static int footer(gp_out *o)
     return gp_out_flush(o);
 }
 
-static int write_mesh(gp_out *o, const gp_result *result)
-{
-    const gp_mesh *m = &result->mesh;
-    size_t cells = m->ntri + m->nquad;
-    int tn = gp_mesh_tri_nodes(m->order), qn = gp_mesh_quad_nodes(m->order);
-    header(o, m->nnodes, cells);
-    points(o, m->xy, 2, m->nnodes);
-    array a = open_array(o, "Int64", "connectivity", 1);
-    for (size_t k = 0; k < (size_t)tn * m->ntri; k++)
-        put_int(&a, m->tri[k]);
-    for (size_t k = 0; k < (size_t)qn * m->nquad; k++)
-        put_int(&a, m->quad[k]);
-    close_array(&a);
-    a = open_array(o, "Int64", "offsets", 1);
-    for (size_t e = 0; e < cells; e++)
-        put_int(&a, e < m->ntri ? (int64_t)(tn * (e + 1))
-                                : (int64_t)(tn * m->ntri + qn * (e + 1 - m->ntri)));
-    close_array(&a);
-    a = open_array(o, "UInt8", "types", 1);
-    for (size_t e = 0; e < cells; e++)
-        put_int(&a, e < m->ntri ? (m->order == 2 ? VTK_QUADRATIC_TRIANGLE : VTK_TRIANGLE)
-                                : (m->order == 2 ? VTK_QUADRATIC_QUAD : VTK_QUAD));
-    close_array(&a);
-    gp_out_puts(o, "</Cells>\n<CellData Scalars=\"region\">\n");
-    a = open_array(o, "Int32", "region", 1);
-    for (size_t e = 0; e < cells; e++)
-        put_int(&a, e < m->ntri ? m->tri_region[e] : m->quad_region[e - m->ntri]);
-    close_array(&a);
-    a = open_array(o, "Int32", "phase", 1);
-    for (size_t e = 0; e < cells; e++)
-        put_int(&a, gp_mesh_region_phase(m, e < m->ntri ? m->tri_region[e] : m->quad_region[e - m->ntri]));
-    close_array(&a);
-    a = open_array(o, "Float64", "grain_radius", 1);
-    for (size_t e = 0; e < cells; e++) {
-        int32_t r = e < m->ntri ? m->tri_region[e] : m->quad_region[e - m->ntri];
-        put_double(&a, (size_t)r < m->ngrains ? result->packing.disks[r].r : 0.0);
-    }
-    close_array(&a);
-    a = open_array(o, "Float64", "quality", 1);
-    for (size_t e = 0; e < cells; e++)
-        put_double(&a, e < m->ntri ? gp_mesh_element_quality(m, 0, e)
-                                   : gp_mesh_element_quality(m, 1, e - m->ntri));
-    close_array(&a);
-    gp_out_puts(o, "</CellData>\n");
-    return footer(o);
-}
-
 /* The per-grain arrays, in grain order: cell data of polygons or point data of vertices. */
 static void grain_arrays(gp_out *o, const gp_result *result)
 {
@@ -218,11 +172,170 @@ static int write_grains(gp_out *o, const gp_result *result)
     return footer(o);
 }
 
+/* The mesh, window by window: the state carries the data array being written (its
+ * values so far, for the line breaks) and the grains' window of the radii. */
+typedef struct vtu_state {
+    array a;
+    gp_grain_window grains;
+} vtu_state;
+
+/* The arrays of the elements' cell data, in the order they are written. */
+enum { CONNECTIVITY, OFFSETS, TYPES, REGION, PHASE, GRAIN_RADIUS, QUALITY, ARRAYS };
+static const struct {
+    const char *type, *name;
+} cell_array[ARRAYS] = {
+    {"Int64", "connectivity"}, {"Int64", "offsets"}, {"UInt8", "types"}, {"Int32", "region"},
+    {"Int32", "phase"}, {"Float64", "grain_radius"}, {"Float64", "quality"},
+};
+
+/* Opens data array `param` after closing the one before it (what separates them). */
+static void next_array(gp_writer *w, gp_out *o, int param)
+{
+    vtu_state *st = w->state;
+    if (param == CONNECTIVITY) {
+        close_array(&st->a);
+        gp_out_puts(o, "</Points>\n<Cells>\n");
+    } else {
+        close_array(&st->a);
+        if (param == REGION)
+            gp_out_puts(o, "</Cells>\n<CellData Scalars=\"region\">\n");
+    }
+    st->a = open_array(o, cell_array[param].type, cell_array[param].name, 1);
+}
+
+static void head(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    vtu_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    if (gp_mesh_plan_check(w, o))
+        return;
+    header(o, m->nnodes, m->ntri + m->nquad);
+    st->a = open_array(o, "Float64", "Points", 3);
+}
+
+static void point(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)param;
+    vtu_state *st = w->state;
+    const double *xy = gp_writer_mesh(w, o, GP_MESH_XY, k);
+    if (!xy)
+        return;
+    put_double(&st->a, xy[0]);
+    put_double(&st->a, xy[1]);
+    put_int(&st->a, 0);
+}
+
+static void connectivity(gp_writer *w, gp_out *o, size_t e, int quad)
+{
+    vtu_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    int n = quad ? gp_mesh_quad_nodes(m->order) : gp_mesh_tri_nodes(m->order);
+    const int32_t *c = gp_writer_mesh(w, o, quad ? GP_MESH_QUAD : GP_MESH_TRI, e);
+    for (int k = 0; c && k < n; k++)
+        put_int(&st->a, c[k]);
+}
+
+/* The radius of grain r (a region that is a grain), from the grains' window that holds
+ * it: the regions grow along the elements, so the windows follow one another. */
+static double grain_radius(gp_writer *w, gp_out *o, size_t r)
+{
+    vtu_state *st = w->state;
+    gp_grain_window *g = &st->grains;
+    if (!g->disks || r < g->first || r - g->first >= g->count) {
+        int rc = w->source.load(w->source.ctx, GP_GRAINS_DISKS, r, g);
+        if (rc || !g->disks) {
+            g->disks = NULL;
+            if (!o->err)
+                o->err = rc ? rc : GP_EINVAL;
+            return 0.0;
+        }
+    }
+    return g->disks[r - g->first].r;
+}
+
+/* Element e's value in the cell array `param`. */
+static void cell_value(gp_writer *w, gp_out *o, size_t e, int param)
+{
+    vtu_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    int tn = gp_mesh_tri_nodes(m->order), qn = gp_mesh_quad_nodes(m->order);
+    int tri = e < m->ntri;
+    switch (param) {
+    case OFFSETS:
+        put_int(&st->a, tri ? (int64_t)(tn * (e + 1)) : (int64_t)(tn * m->ntri + qn * (e + 1 - m->ntri)));
+        return;
+    case TYPES:
+        put_int(&st->a, tri ? (m->order == 2 ? VTK_QUADRATIC_TRIANGLE : VTK_TRIANGLE)
+                            : (m->order == 2 ? VTK_QUADRATIC_QUAD : VTK_QUAD));
+        return;
+    case QUALITY: {
+        const double *q = gp_writer_mesh(w, o, GP_MESH_QUALITY, e);
+        if (q)
+            put_double(&st->a, *q);
+        return;
+    }
+    default:
+        break;
+    }
+    int32_t r = gp_mesh_plan_region(w, o, e);
+    if (r < 0)
+        return;
+    if (param == REGION)
+        put_int(&st->a, r);
+    else if (param == PHASE)
+        put_int(&st->a, gp_mesh_region_phase(m, r));
+    else
+        put_double(&st->a, (size_t)r < m->ngrains ? grain_radius(w, o, (size_t)r) : 0.0);
+}
+
+static void tail(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    vtu_state *st = w->state;
+    close_array(&st->a);
+    gp_out_puts(o, "</CellData>\n");
+    int rc = footer(o);
+    if (rc && !o->err)
+        o->err = rc;
+}
+
+/* The grains, without a mesh: in one step, from the result's arrays. */
+static void grains_whole(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    if (gp_mesh_plan_check(w, o))
+        return;
+    int rc = write_grains(o, w->result);
+    if (rc && !o->err)
+        o->err = rc;
+}
+
+int gp_plan_vtu(gp_writer *w)
+{
+    if (!w->result->has_mesh) {
+        gp_writer_text(w, grains_whole, 0);
+        return 0;
+    }
+    if (!(w->state = calloc(1, sizeof(vtu_state))))
+        return GP_ENOMEM;
+    const gp_mesh *m = &w->result->mesh;
+    size_t cells = m->ntri + m->nquad;
+    gp_writer_text(w, head, 0);
+    gp_writer_items(w, point, m->nnodes, 0);
+    gp_writer_text(w, next_array, CONNECTIVITY);
+    gp_writer_items(w, connectivity, m->ntri, 0);
+    gp_writer_items(w, connectivity, m->nquad, 1);
+    for (int a = OFFSETS; a < ARRAYS; a++) {
+        gp_writer_text(w, next_array, a);
+        gp_writer_items(w, cell_value, cells, a);
+    }
+    gp_writer_text(w, tail, 0);
+    return 0;
+}
+
 int gp_write_vtu(gp_out *o, const gp_spec *spec, const gp_result *result)
 {
-    (void)spec;
     int checked = gp_mesh_result_check(result, GP_FORMAT_VTU, NULL);
-    if (checked)
-        return checked;
-    return result->has_mesh ? write_mesh(o, result) : write_grains(o, result);
+    return checked ? checked : gp_write_result(o, GP_FORMAT_VTU, spec, result);
 }

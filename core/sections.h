@@ -25,6 +25,9 @@
  *   "mesh_quad_region" per quadrilateral: its region (i32)
  *   "mesh_bedge"      per boundary edge: its order + 1 node indices (i32)
  *   "mesh_bedge_side" per boundary edge: its gp_mesh_side (u8)
+ *   "mesh_quality"    per element, triangles then quadrilaterals: its quality (f64,
+ *                     gp_mesh_element_quality); stored since meshes are downloaded window
+ *                     by window (a result stored before has none: vtu then reads it whole)
  * The small sections ("pack", "balance", "cells", "mesh") make a result's summary: the statistics
  * and everything a writer needs but the per-grain arrays, which a writer reads window by
  * window through gp_sections_source (below) without holding the whole result.
@@ -62,10 +65,11 @@ extern "C" {
 #define GP_SECTION_MESH_QUAD_REGION "mesh_quad_region"
 #define GP_SECTION_MESH_BEDGE "mesh_bedge"
 #define GP_SECTION_MESH_BEDGE_SIDE "mesh_bedge_side"
+#define GP_SECTION_MESH_QUALITY "mesh_quality"
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24
-/* The most sections a result has today: 9 for the grains, 8 for the mesh, and room for a
+/* The most sections a result has today: 9 for the grains, 9 for the mesh, and room for a
  * few more. */
 #define GP_SECTIONS_MAX 24
 
@@ -101,11 +105,21 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
 typedef int (*gp_section_read_fn)(void *ctx, const char *tag, uint64_t offset, void *dst,
                                   size_t len);
 
-/* Reads the mesh's arrays whole (the mesh formats are not written window by window)
- * into summary->mesh, whose counts the "mesh" section set; nothing when they are read
+/* Reads the mesh's arrays whole (for the SVG picture's edges, a mesh under its cap, and
+ * a vtu of a result stored without its qualities) into summary->mesh, whose counts the "mesh" section set; nothing when they are read
  * already. Returns 0, GP_EINVAL (no mesh), GP_ENOMEM, the reader's error, or GP_EPARSE
  * when a node index or a region is out of range. What it reads is owned by `summary`. */
 int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx);
+
+/* The mesh of a stored result (summary->has_mesh), read through `read` (ctx is its
+ * argument) `window` records of each array at a time (0: GP_MESH_WINDOW_RECORDS), node
+ * indices, regions and sides checked as they are read (GP_EPARSE). `quality`: whether the
+ * result has the "mesh_quality" section (without it, loading the qualities fails with
+ * GP_EINVAL). `summary` is borrowed and must outlive the source. Returns 0, GP_EINVAL (no
+ * mesh) or GP_ENOMEM; free with gp_mesh_source_free. */
+struct gp_mesh_source;
+int gp_sections_mesh_source(const gp_result *summary, gp_section_read_fn read, void *ctx,
+                            size_t window, int quality, struct gp_mesh_source *out);
 
 /* Grains a window of a stored result holds: the buffers then take about 300 bytes a
  * grain (disks, F, area, a cell's six or so vertices), some 300 KB. */

@@ -8,6 +8,8 @@
 #include <zlib.h>
 
 #include "sections.h"
+#include "io_svg_mesh.h"
+#include "mesh_source.h"
 #include "log.h"
 
 /* What the writer renders in one go: libmicrohttpd asks for as much as is free in its
@@ -28,8 +30,8 @@ typedef struct gp_download {
     gp_format format;
     gp_result_reader *reader;
     gp_sections_source *source;
-    gp_sections_source *whole; /* VTU's grains, read in one window (io_mesh_plan.c) */
-    int loaded;                /* what the mesh formats read whole is in res.summary */
+    gp_sections_source *whole; /* a vtu's grains without a mesh, read in one window */
+    int loaded;                /* load_whole ran */
     gp_writer *writer;
     gp_out text;       /* rendered; bytes from `sent` on not handed on yet */
     size_t sent;
@@ -45,18 +47,36 @@ static int read_section(void *ctx, const char *tag, uint64_t offset, void *dst, 
     return d->db ? gp_result_reader_read(d->reader, d->db, tag, offset, dst, len) : GP_SRV_EDB;
 }
 
-/* The mesh formats read the result whole, not window by window: the mesh's arrays
- * (msh, inp, vtu, and svg which draws the edges) and, for vtu, the grains' arrays, lent
- * to the summary from one window over all grains (taken back in release). Returns 0 or
- * the reader's error. */
+/* Sets up what a format reads besides the per-grain windows. The mesh formats read the
+ * mesh window by window (msh, inp, vtu), but for a vtu of a result stored before the
+ * elements' qualities were (they need each element's nodes: the mesh is then read whole,
+ * as it used to be), and the SVG picture draws the edges of a mesh under its cap (read
+ * whole: some ten megabytes at most), nothing beyond. A vtu of the grains without a mesh
+ * reads them in one window over all grains, lent to the summary (taken back in release).
+ * Returns 0 or the reader's error. */
 static int load_whole(gp_download *d)
 {
     gp_result *r = &d->res.summary;
     int rc = 0;
     if (r->has_mesh && (d->format == GP_FORMAT_MSH || d->format == GP_FORMAT_INP ||
-                        d->format == GP_FORMAT_VTU || d->format == GP_FORMAT_SVG))
-        rc = gp_sections_read_mesh(r, read_section, d);
-    if (rc == 0 && d->format == GP_FORMAT_VTU && r->packing.count > 0) {
+                        (d->format == GP_FORMAT_VTU && d->res.mesh_quality))) {
+        gp_mesh_source src;
+        if ((rc = gp_sections_mesh_source(r, read_section, d, 0, d->res.mesh_quality, &src)))
+            return rc;
+        gp_writer_set_mesh(d->writer, &src);
+        return 0;
+    }
+    if (r->has_mesh && d->format == GP_FORMAT_VTU) {
+        gp_mesh_source src;
+        if ((rc = gp_sections_read_mesh(r, read_section, d)) ||
+            (rc = gp_mesh_source_memory(&r->mesh, &src)))
+            return rc;
+        gp_writer_set_mesh(d->writer, &src);
+        return 0;
+    }
+    if (r->has_mesh && d->format == GP_FORMAT_SVG && gp_svg_mesh_drawable(&r->mesh))
+        return gp_sections_read_mesh(r, read_section, d);
+    if (d->format == GP_FORMAT_VTU && r->packing.count > 0) {
         if (!(d->whole = gp_sections_source_new(r, read_section, d, r->packing.count)))
             return GP_ENOMEM;
         unsigned needs = GP_GRAINS_DISKS | (r->has_balance ? GP_GRAINS_F : 0) |

@@ -162,7 +162,7 @@ static int open_summary(pg_db *db, const char *id, gp_stored_result *res)
         found[n].bytes = (uint64_t)atoll(PQgetvalue(r, row, 3));
     }
     PQclear(r);
-    return gp_store_decode_summary((gp_db *)(void *)db, id, found, n, &res->summary);
+    return gp_store_decode_summary((gp_db *)(void *)db, id, found, n, res);
 }
 
 int gp_pg_open_result(gp_db *d, const char *id, const char *owner, gp_stored_result *out)

@@ -38,8 +38,9 @@ static int read_whole(gp_db *db, const gp_section_ref *ref, unsigned char **out)
 }
 
 int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *refs, size_t n,
-                            gp_result *summary)
+                            gp_stored_result *res)
 {
+    gp_result *summary = &res->summary;
     int have_pack = 0;
     for (size_t i = 0; i < n; i++) {
         unsigned char *bytes = NULL;
@@ -56,6 +57,7 @@ int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *ref
         if (rc)
             return rc;
         have_pack |= strcmp(refs[i].tag, GP_SECTION_PACK) == 0;
+        res->mesh_quality |= strcmp(refs[i].tag, GP_SECTION_MESH_QUALITY) == 0;
     }
     return have_pack ? 0 : GP_SRV_ENOTFOUND;
 }

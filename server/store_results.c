@@ -146,7 +146,7 @@ static int open_summary(gp_db *db, const char *id, gp_stored_result *res)
     sqlite3_reset(s);
     if (rc != SQLITE_ROW && rc != SQLITE_DONE)
         return gp_db_fail(db, "list result sections");
-    return gp_store_decode_summary(db, id, found, n, &res->summary);
+    return gp_store_decode_summary(db, id, found, n, res);
 }
 
 int sq_open_result(gp_db *db, const char *id, const char *owner, gp_stored_result *out)
