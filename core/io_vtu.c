@@ -1,6 +1,6 @@
 /* io_vtu.c - the result as a VTK XML unstructured grid (ASCII), which ParaView, VTK and
  * meshio read: the mesh with its cell data, or without a mesh the grains themselves
- * (cells as polygons, or disk centres as vertices). */
+ * (cells as polygons, or disk centres as vertices), each written window by window. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -74,102 +74,10 @@ static void header(gp_out *o, size_t points, size_t cells)
     gp_out_puts(o, "\">\n<Points>\n");
 }
 
-static void points(gp_out *o, const double *xy, size_t stride, size_t n)
-{
-    array a = open_array(o, "Float64", "Points", 3);
-    for (size_t k = 0; k < n; k++) {
-        put_double(&a, xy[stride * k]);
-        put_double(&a, xy[stride * k + 1]);
-        put_int(&a, 0);
-    }
-    close_array(&a);
-    gp_out_puts(o, "</Points>\n<Cells>\n");
-}
-
 static int footer(gp_out *o)
 {
     gp_out_puts(o, "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     return gp_out_flush(o);
-}
-
-/* The per-grain arrays, in grain order: cell data of polygons or point data of vertices. */
-static void grain_arrays(gp_out *o, const gp_result *result)
-{
-    const gp_packing *p = &result->packing;
-    array a = open_array(o, "Int64", "grain_id", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_int(&a, (int64_t)i);
-    close_array(&a);
-    a = open_array(o, "Float64", "radius", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_double(&a, p->disks[i].r);
-    close_array(&a);
-    a = open_array(o, "Float64", "packing_radius", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_double(&a, p->disks[i].R);
-    close_array(&a);
-    if (result->has_cells) {
-        const gp_cells *c = &result->cells;
-        a = open_array(o, "Float64", "area", 1);
-        for (size_t i = 0; i < c->count; i++)
-            put_double(&a, c->area[i]);
-        close_array(&a);
-        a = open_array(o, "Int32", "neighbours", 1);
-        for (size_t i = 0; i < c->count; i++)
-            put_int(&a, (int64_t)(c->nstart[i + 1] - c->nstart[i]));
-        close_array(&a);
-    }
-    if (result->has_balance) {
-        a = open_array(o, "Float64", "F", 1);
-        for (size_t i = 0; i < p->count; i++)
-            put_double(&a, isnan(result->balance.F[i]) ? VTU_NO_QUALITY : result->balance.F[i]);
-        close_array(&a);
-    }
-}
-
-static int write_grains(gp_out *o, const gp_result *result)
-{
-    const gp_packing *p = &result->packing;
-    if (result->has_cells) {
-        const gp_cells *c = &result->cells;
-        size_t nv = c->start[c->count];
-        header(o, nv, c->count);
-        points(o, c->xy, 2, nv);
-        array a = open_array(o, "Int64", "connectivity", 1);
-        for (size_t k = 0; k < nv; k++)
-            put_int(&a, (int64_t)k);
-        close_array(&a);
-        a = open_array(o, "Int64", "offsets", 1);
-        for (size_t i = 0; i < c->count; i++)
-            put_int(&a, (int64_t)c->start[i + 1]);
-        close_array(&a);
-        a = open_array(o, "UInt8", "types", 1);
-        for (size_t i = 0; i < c->count; i++)
-            put_int(&a, VTK_POLYGON);
-        close_array(&a);
-        gp_out_puts(o, "</Cells>\n<CellData Scalars=\"radius\">\n");
-        grain_arrays(o, result);
-        gp_out_puts(o, "</CellData>\n");
-        return footer(o);
-    }
-    header(o, p->count, p->count);
-    points(o, p->count ? &p->disks[0].x : NULL, sizeof(gp_disk) / sizeof(double), p->count);
-    array a = open_array(o, "Int64", "connectivity", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_int(&a, (int64_t)i);
-    close_array(&a);
-    a = open_array(o, "Int64", "offsets", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_int(&a, (int64_t)i + 1);
-    close_array(&a);
-    a = open_array(o, "UInt8", "types", 1);
-    for (size_t i = 0; i < p->count; i++)
-        put_int(&a, VTK_VERTEX);
-    close_array(&a);
-    gp_out_puts(o, "</Cells>\n<PointData Scalars=\"radius\">\n");
-    grain_arrays(o, result);
-    gp_out_puts(o, "</PointData>\n");
-    return footer(o);
 }
 
 /* The mesh, window by window: the state carries the data array being written (its
@@ -300,25 +208,144 @@ static void tail(gp_writer *w, gp_out *o, int param)
         o->err = rc;
 }
 
-/* The grains, without a mesh: in one step, from the result's arrays. */
-static void grains_whole(gp_writer *w, gp_out *o, int param)
+/* --- the grains without a mesh, window by window: polygons (with cells) or vertices --- */
+
+/* The data arrays of the grains, in the order they are written. */
+enum { G_POINTS, G_CONNECTIVITY, G_OFFSETS, G_TYPES, G_ID, G_RADIUS, G_PACKING_RADIUS, G_AREA,
+       G_NEIGHBOURS, G_F, G_ARRAYS };
+static const struct {
+    const char *type, *name;
+} grain_array[G_ARRAYS] = {
+    {"Float64", "Points"}, {"Int64", "connectivity"}, {"Int64", "offsets"}, {"UInt8", "types"},
+    {"Int64", "grain_id"}, {"Float64", "radius"}, {"Float64", "packing_radius"}, {"Float64", "area"},
+    {"Int32", "neighbours"}, {"Float64", "F"},
+};
+
+/* Opens grain array `param` after closing the one before it (what separates them). */
+static void grain_array_open(gp_writer *w, gp_out *o, int param)
+{
+    vtu_state *st = w->state;
+    if (param == G_POINTS) {
+        const gp_result *r = w->result;
+        size_t n = r->packing.count;
+        header(o, r->has_cells ? w->source.vertex_count : n, n);
+    } else {
+        close_array(&st->a);
+    }
+    if (param == G_CONNECTIVITY)
+        gp_out_puts(o, "</Points>\n<Cells>\n");
+    else if (param == G_ID)
+        gp_out_puts(o, w->result->has_cells ? "</Cells>\n<CellData Scalars=\"radius\">\n"
+                                            : "</Cells>\n<PointData Scalars=\"radius\">\n");
+    st->a = open_array(o, grain_array[param].type, grain_array[param].name, param == G_POINTS ? 3 : 1);
+}
+
+static void grains_end(gp_writer *w, gp_out *o, int param)
 {
     (void)param;
-    if (gp_mesh_plan_check(w, o))
-        return;
-    int rc = write_grains(o, w->result);
+    vtu_state *st = w->state;
+    close_array(&st->a);
+    gp_out_puts(o, w->result->has_cells ? "</CellData>\n" : "</PointData>\n");
+    int rc = footer(o);
     if (rc && !o->err)
         o->err = rc;
 }
 
+/* A grain's points: its cell's vertices, or its disk's centre. */
+static void grain_points(gp_writer *w, gp_out *o, const gp_grain_window *win, size_t j, int param)
+{
+    (void)o;
+    (void)param;
+    vtu_state *st = w->state;
+    if (!w->result->has_cells) {
+        put_double(&st->a, win->disks[j].x);
+        put_double(&st->a, win->disks[j].y);
+        put_int(&st->a, 0);
+        return;
+    }
+    for (size_t k = win->start[j]; k < win->start[j + 1]; k++) {
+        put_double(&st->a, win->xy[2 * (k - win->vertex_base)]);
+        put_double(&st->a, win->xy[2 * (k - win->vertex_base) + 1]);
+        put_int(&st->a, 0);
+    }
+}
+
+/* Item k's value k + param (point indices, grain ids, a vertex's offset). */
+static void index_value(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)o;
+    vtu_state *st = w->state;
+    put_int(&st->a, (int64_t)k + param);
+}
+
+/* The VTK cell type `param`, once per item. */
+static void cell_type(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)o;
+    (void)k;
+    vtu_state *st = w->state;
+    put_int(&st->a, param);
+}
+
+/* Grain j's value in grain array `param`. */
+static void grain_value(gp_writer *w, gp_out *o, const gp_grain_window *win, size_t j, int param)
+{
+    (void)o;
+    vtu_state *st = w->state;
+    switch (param) {
+    case G_OFFSETS: put_int(&st->a, (int64_t)win->start[j + 1]); break;
+    case G_RADIUS: put_double(&st->a, win->disks[j].r); break;
+    case G_PACKING_RADIUS: put_double(&st->a, win->disks[j].R); break;
+    case G_AREA: put_double(&st->a, win->area[j]); break;
+    case G_NEIGHBOURS: put_int(&st->a, (int64_t)(win->nstart[j + 1] - win->nstart[j])); break;
+    default: put_double(&st->a, isnan(win->F[j]) ? VTU_NO_QUALITY : win->F[j]); break;
+    }
+}
+
+static void plan_grains(gp_writer *w)
+{
+    const gp_result *r = w->result;
+    size_t n = r->packing.count;
+    int cells = r->has_cells;
+    gp_writer_text(w, grain_array_open, G_POINTS);
+    gp_writer_grains(w, grain_points, cells ? GP_GRAINS_POLYGONS : GP_GRAINS_DISKS, 0);
+    gp_writer_text(w, grain_array_open, G_CONNECTIVITY);
+    gp_writer_items(w, index_value, cells ? w->source.vertex_count : n, 0);
+    gp_writer_text(w, grain_array_open, G_OFFSETS);
+    if (cells)
+        gp_writer_grains(w, grain_value, GP_GRAINS_POLYGONS, G_OFFSETS);
+    else
+        gp_writer_items(w, index_value, n, 1);
+    gp_writer_text(w, grain_array_open, G_TYPES);
+    gp_writer_items(w, cell_type, n, cells ? VTK_POLYGON : VTK_VERTEX);
+    gp_writer_text(w, grain_array_open, G_ID);
+    gp_writer_items(w, index_value, n, 0);
+    const struct {
+        int array, present;
+        unsigned needs;
+    } values[] = {
+        {G_RADIUS, 1, GP_GRAINS_DISKS},
+        {G_PACKING_RADIUS, 1, GP_GRAINS_DISKS},
+        {G_AREA, cells, GP_GRAINS_AREA},
+        {G_NEIGHBOURS, cells, GP_GRAINS_NEIGHBOURS},
+        {G_F, r->has_balance, GP_GRAINS_F},
+    };
+    for (size_t v = 0; v < sizeof values / sizeof *values; v++)
+        if (values[v].present) {
+            gp_writer_text(w, grain_array_open, values[v].array);
+            gp_writer_grains(w, grain_value, values[v].needs, values[v].array);
+        }
+    gp_writer_text(w, grains_end, 0);
+}
+
 int gp_plan_vtu(gp_writer *w)
 {
-    if (!w->result->has_mesh) {
-        gp_writer_text(w, grains_whole, 0);
-        return 0;
-    }
     if (!(w->state = calloc(1, sizeof(vtu_state))))
         return GP_ENOMEM;
+    if (!w->result->has_mesh) {
+        plan_grains(w);
+        return 0;
+    }
     const gp_mesh *m = &w->result->mesh;
     size_t cells = m->ntri + m->nquad;
     gp_writer_text(w, head, 0);

@@ -14,7 +14,8 @@
 #endif
 _Static_assert(sizeof(gp_disk) == 32, "a disk is stored as four doubles");
 
-/* The version of every section's layout this build writes (and the only one it reads). */
+/* The version of every section's layout this build writes (and the only one it reads),
+ * but the mesh summary's (GP_SECTION_MESH_VERSION). */
 #define LAYOUT_V1 1
 
 /* --- encoding --- */
@@ -272,6 +273,7 @@ int gp_sections_from_result(const gp_result *r, gp_section *s, size_t *n)
         if (e.failed)
             goto fail;
         add(s, n, GP_SECTION_MESH, 1, NULL, 0, &e);
+        s[*n - 1].version = GP_SECTION_MESH_VERSION;
         add(s, n, GP_SECTION_MESH_XY, 0, m->xy, 2 * m->nnodes * sizeof(double), NULL);
         add(s, n, GP_SECTION_MESH_TRI, 0, m->tri,
             m->ntri * (size_t)gp_mesh_tri_nodes(m->order) * sizeof(int32_t), NULL);
@@ -539,7 +541,8 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
         decode = decode_mesh;
     if (!decode)
         return 0;
-    if (version != LAYOUT_V1)
+    /* the mesh summary's layout is the same in both its versions */
+    if (version != LAYOUT_V1 && !(decode == decode_mesh && version == GP_SECTION_MESH_VERSION))
         return GP_EINVAL;
     dec d = {data, size, 0};
     int rc = decode(&d, summary);

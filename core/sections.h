@@ -2,7 +2,8 @@
  * each stage produced, each section named by a tag, with the version of its layout, so
  * that a reader skips tags it does not know and a later stage (a mesh) adds its own.
  *
- * Tags and layouts (version 1; little-endian; f64 = IEEE double, u32/u64/i32 integers):
+ * Tags and layouts (version 1 but "mesh"; little-endian; f64 = IEEE double, u32/u64/i32
+ * integers):
  *   "pack"            the packing's diagnostics (with the front's rule and, for the waiting
  *                     rule, wait_levels and alive_quantile) and statistics (gp_pack_stats,
  *                     with its bins)
@@ -17,7 +18,10 @@
  *   "cell_neighbours" per neighbour: its grain id (i32), cell after cell
  *   "mesh"            the mesh's summary: kind, order, counts, each region's polygon area,
  *                     gp_mesh_stats (its periodic node pairs and rounds last: a summary
- *                     stored before them ends without, and reads as 0)
+ *                     stored before them ends without, and reads as 0). Version 2
+ *                     (GP_SECTION_MESH_VERSION) has the layout of version 1 and says that
+ *                     "mesh_quality" is stored: a reader lists only the summary sections,
+ *                     so the version is where it learns it
  *   "mesh_xy"         per node: x, y (f64 each)
  *   "mesh_tri"        per triangle: its 3 (order 1) or 6 (order 2) node indices (i32)
  *   "mesh_tri_region" per triangle: its region (i32)
@@ -26,8 +30,9 @@
  *   "mesh_bedge"      per boundary edge: its order + 1 node indices (i32)
  *   "mesh_bedge_side" per boundary edge: its gp_mesh_side (u8)
  *   "mesh_quality"    per element, triangles then quadrilaterals: its quality (f64,
- *                     gp_mesh_element_quality); stored since meshes are downloaded window
- *                     by window (a result stored before has none: vtu then reads it whole)
+ *                     gp_mesh_element_quality); stored with "mesh" version 2, since meshes
+ *                     are downloaded window by window (a result stored before has none: a
+ *                     vtu download then reads its mesh whole)
  * The small sections ("pack", "balance", "cells", "mesh") make a result's summary: the statistics
  * and everything a writer needs but the per-grain arrays, which a writer reads window by
  * window through gp_sections_source (below) without holding the whole result.
@@ -66,6 +71,9 @@ extern "C" {
 #define GP_SECTION_MESH_BEDGE "mesh_bedge"
 #define GP_SECTION_MESH_BEDGE_SIDE "mesh_bedge_side"
 #define GP_SECTION_MESH_QUALITY "mesh_quality"
+
+/* The version of the "mesh" section this build writes: 2, its qualities stored. */
+#define GP_SECTION_MESH_VERSION 2
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24

@@ -126,6 +126,16 @@ void gp_writer_free(gp_writer *w)
     free(w);
 }
 
+/* Whether `win` lacks an array of `needs`: a result in memory with only its counts (a
+ * summary) has none, and a pass must not read through NULL. */
+static int missing(const gp_grain_window *win, unsigned needs)
+{
+    return ((needs & GP_GRAINS_DISKS) && !win->disks) || ((needs & GP_GRAINS_F) && !win->F) ||
+           ((needs & GP_GRAINS_AREA) && !win->area) ||
+           ((needs & GP_GRAINS_POLYGONS) && (!win->start || !win->xy)) ||
+           ((needs & GP_GRAINS_NEIGHBOURS) && (!win->nstart || !win->neighbours));
+}
+
 /* Runs the pass of step s from grain w->next until the grains end or out holds `want`
  * bytes. Returns 0 or the source's error. */
 static int run_pass(gp_writer *w, const gp_writer_step *s, gp_out *out, size_t want)
@@ -135,6 +145,10 @@ static int run_pass(gp_writer *w, const gp_writer_step *s, gp_out *out, size_t w
         int rc = w->source.load(w->source.ctx, s->needs, w->next, &win);
         if (rc)
             return rc;
+        if (missing(&win, s->needs))
+            return gp_error_set(&w->error, GP_EINVAL, NULL,
+                                "%s needs the grains' arrays in the result, which has only their counts",
+                                gp_format_name(w->format));
         size_t j = w->next - win.first;
         while (j < win.count && out->len < want) /* a file sink keeps len below its capacity */
             s->grain(w, out, &win, j++, s->param);

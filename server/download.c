@@ -30,8 +30,7 @@ typedef struct gp_download {
     gp_format format;
     gp_result_reader *reader;
     gp_sections_source *source;
-    gp_sections_source *whole; /* a vtu's grains without a mesh, read in one window */
-    int loaded;                /* load_whole ran */
+    int loaded;                /* load_mesh ran */
     gp_writer *writer;
     gp_out text;       /* rendered; bytes from `sent` on not handed on yet */
     size_t sent;
@@ -51,13 +50,11 @@ static int read_section(void *ctx, const char *tag, uint64_t offset, void *dst, 
  * mesh window by window (msh, inp, vtu), but for a vtu of a result stored before the
  * elements' qualities were (they need each element's nodes: the mesh is then read whole,
  * as it used to be), and the SVG picture draws the edges of a mesh under its cap (read
- * whole: some ten megabytes at most), nothing beyond. A vtu of the grains without a mesh
- * reads them in one window over all grains, lent to the summary (taken back in release).
- * Returns 0 or the reader's error. */
-static int load_whole(gp_download *d)
+ * whole: some ten megabytes at most), nothing beyond. Returns 0 or the reader's error. */
+static int load_mesh(gp_download *d)
 {
     gp_result *r = &d->res.summary;
-    int rc = 0;
+    int rc;
     if (r->has_mesh && (d->format == GP_FORMAT_MSH || d->format == GP_FORMAT_INP ||
                         (d->format == GP_FORMAT_VTU && d->res.mesh_quality))) {
         gp_mesh_source src;
@@ -76,27 +73,7 @@ static int load_whole(gp_download *d)
     }
     if (r->has_mesh && d->format == GP_FORMAT_SVG && gp_svg_mesh_drawable(&r->mesh))
         return gp_sections_read_mesh(r, read_section, d);
-    if (d->format == GP_FORMAT_VTU && r->packing.count > 0) {
-        if (!(d->whole = gp_sections_source_new(r, read_section, d, r->packing.count)))
-            return GP_ENOMEM;
-        unsigned needs = GP_GRAINS_DISKS | (r->has_balance ? GP_GRAINS_F : 0) |
-                         (r->has_cells ? GP_GRAINS_AREA | GP_GRAINS_POLYGONS | GP_GRAINS_NEIGHBOURS : 0);
-        gp_grain_source g = gp_sections_source_grains(d->whole);
-        gp_grain_window win;
-        if ((rc = g.load(g.ctx, needs, 0, &win)))
-            return rc;
-        r->packing.disks = (gp_disk *)win.disks;
-        if (r->has_balance)
-            r->balance.F = (double *)win.F;
-        if (r->has_cells) {
-            r->cells.area = (double *)win.area;
-            r->cells.start = (size_t *)win.start;
-            r->cells.xy = (double *)win.xy;
-            r->cells.nstart = (size_t *)win.nstart;
-            r->cells.neighbours = (int32_t *)win.neighbours;
-        }
-    }
-    return rc;
+    return 0;
 }
 
 /* Renders on until `text` holds `want` bytes or the writer is done. Returns 0 or the
@@ -111,7 +88,7 @@ static int render(gp_download *d, size_t want)
     }
     int rc = 0;
     if (!d->loaded) {
-        rc = load_whole(d);
+        rc = load_mesh(d);
         d->loaded = rc == 0;
     }
     if (rc == 0)
@@ -190,15 +167,6 @@ static void release(gp_body_stream *s)
         deflateEnd(&d->z);
     gp_writer_free(d->writer);
     gp_sections_source_free(d->source);
-    if (d->whole) { /* the grains lent to the summary are the window's */
-        gp_result *r = &d->res.summary;
-        r->packing.disks = NULL;
-        r->balance.F = NULL;
-        r->cells.area = r->cells.xy = NULL;
-        r->cells.start = r->cells.nstart = NULL;
-        r->cells.neighbours = NULL;
-    }
-    gp_sections_source_free(d->whole);
     gp_result_reader_free(d->reader);
     gp_out_free(&d->text);
     gp_stored_result_free(&d->res);

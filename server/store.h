@@ -209,7 +209,7 @@ typedef struct gp_stored_result {
     size_t spec_len;
     gp_result summary;      /* owned (gp_result_free): per-grain arrays NULL */
     char version[40];       /* changes whenever the stored bytes could (a strong ETag's root) */
-    int mesh_quality;       /* the mesh's qualities are stored (sections.h: "mesh_quality") */
+    int mesh_quality;       /* the mesh's qualities are stored (sections.h: "mesh" version 2) */
 } gp_stored_result;
 
 /* Opens the result of a successful job of `owner`: reads the spec and the summary

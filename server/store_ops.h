@@ -75,7 +75,7 @@ int gp_store_pg_open(const char *uri, gp_store **out, char *why, size_t why_size
 
 /* Decodes the summary sections refs[0..n) of job `id` (read whole through read_chunk)
  * into res->summary, and notes in res->mesh_quality whether the mesh's qualities are
- * among the sections (a result stored before they were has none). Returns 0, GP_SRV_ENOTFOUND (a section is missing or has no packing: the
+ * stored (its "mesh" section's version says so: a result stored before has none). Returns 0, GP_SRV_ENOTFOUND (a section is missing or has no packing: the
  * job was deleted meanwhile), GP_SRV_EDB (a section that cannot be decoded: logged) or
  * GP_ENOMEM. */
 int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *refs, size_t n,

@@ -57,7 +57,8 @@ int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *ref
         if (rc)
             return rc;
         have_pack |= strcmp(refs[i].tag, GP_SECTION_PACK) == 0;
-        res->mesh_quality |= strcmp(refs[i].tag, GP_SECTION_MESH_QUALITY) == 0;
+        res->mesh_quality |= strcmp(refs[i].tag, GP_SECTION_MESH) == 0 &&
+                             refs[i].version == GP_SECTION_MESH_VERSION;
     }
     return have_pack ? 0 : GP_SRV_ENOTFOUND;
 }
