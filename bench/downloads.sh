@@ -13,19 +13,7 @@ cd "$(dirname "$0")/.."
 side=${1:-506}
 runs=${RUNS:-3}
 concurrent=${GP_CONCURRENT:-20}
-if [ -z "${GP_DAEMON:-}" ]; then
-  cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release > /dev/null
-  cmake --build build-bench -j"$(nproc)" --target grainpackd > /dev/null
-  GP_DAEMON=./build-bench/server/grainpackd
-fi
-dir=$(mktemp -d)
-"$GP_DAEMON" --port 0 --data-dir "$dir" --ready-file "$dir/port" --workers 1 \
-  --max-disks 3000000 2> "$dir/log" &
-pid=$!
-trap 'kill "$pid" 2> /dev/null; wait "$pid" 2> /dev/null; rm -rf "$dir"' EXIT
-while [ ! -s "$dir/port" ]; do sleep 0.05; done
-base="http://127.0.0.1:$(cat "$dir/port")"
-load_start=$(cut -d' ' -f1 /proc/loadavg)
+source bench/daemon.sh --max-disks 3000000
 
 spec="{\"inputs\": {\"domain\": {\"width\": $side, \"height\": $side},
   \"distribution\": {\"kind\": \"uniform\", \"min\": 0.06, \"max\": 0.42},
@@ -36,7 +24,6 @@ job=$(curl -s -o /dev/null -w '%header{location}' -H 'Content-Type: application/
   "$base/processes/pack2d/execution")
 until curl -s "$base$job?wait=60" | grep -qE '"status":"(successful|failed|dismissed)"'; do :; done
 t1=$(date +%s.%N)
-rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
 sleep 1  # the worker's trim of malloc's arenas, once the job is stored
 after_job=$(rss VmRSS)
 curl -s "$base$job" | grep -q '"status":"successful"' || { echo "the job failed"; exit 1; }

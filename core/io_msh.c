@@ -4,7 +4,7 @@
 #include <stdlib.h>
 
 #include "grainpack/io_mesh.h"
-#include "writer.h"
+#include "io_mesh_plan.h"
 
 /* Gmsh element types (MSH format reference, "elm-type"). */
 #define MSH_LINE2 1
@@ -33,23 +33,6 @@ static void region_name(gp_out *o, const gp_mesh *m, int32_t region)
         gp_out_puts(o, gp_mesh_phase_name(phase));
     }
     gp_out_char(o, '"');
-}
-
-/* Elements of each region: triangles [tri_start[r], tri_start[r+1]) (they are sorted by
- * region), and the quadrilaterals, all in the last region. */
-static void region_ranges(const gp_mesh *m, size_t *tri_start)
-{
-    size_t nregions = m->ngrains + 1, t = 0;
-    for (size_t r = 0; r <= nregions; r++) {
-        while (t < m->ntri && (size_t)m->tri_region[t] < r)
-            t++;
-        tri_start[r] = t;
-    }
-}
-
-static size_t region_elements(const gp_mesh *m, const size_t *tri_start, size_t r)
-{
-    return tri_start[r + 1] - tri_start[r] + (r == m->ngrains ? m->nquad : 0);
 }
 
 static void bounding_box(gp_out *o, const gp_domain *d)
@@ -87,13 +70,14 @@ static void element(gp_out *o, uint64_t *tag, const int32_t *nodes, int n)
  * copy of curve `left`, `top` of `bottom`, by the translation of one period (the 4 x 4
  * affine matrix, by rows, maps the master's points to the copy's), with every node pair,
  * corners included (gp_mesh_periodic_pairs). Nothing on a walled domain. */
-static int periodic_section(gp_out *o, const gp_domain *d, const gp_mesh *m)
+static int periodic_section(gp_writer *w, gp_out *o)
 {
+    const gp_domain *d = &w->spec->domain;
     int32_t *pairs[2] = {NULL, NULL};
     size_t n[2] = {0, 0}, links = 0;
     int rc = 0;
     for (int axis = 0; axis < 2 && rc == 0; axis++) {
-        rc = gp_mesh_periodic_pairs(m, d, axis, &pairs[axis], &n[axis]);
+        rc = gp_mesh_plan_pairs(w, o, axis, &pairs[axis], &n[axis]);
         links += n[axis] > 0;
     }
     if (rc == 0 && links) {
@@ -137,31 +121,42 @@ static int periodic_section(gp_out *o, const gp_domain *d, const gp_mesh *m)
     return rc;
 }
 
-int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
-{
-    int checked = gp_mesh_result_check(result, GP_FORMAT_MSH, NULL);
-    if (checked)
-        return checked;
-    const gp_mesh *m = &result->mesh;
-    size_t nregions = m->ngrains + 1;
-    size_t *tri_start = malloc((nregions + 1) * sizeof *tri_start);
-    if (!tri_start)
-        return GP_ENOMEM;
-    region_ranges(m, tri_start);
-    size_t side_count[GP_SIDE_COUNT] = {0}, surfaces = 0;
-    for (size_t e = 0; e < m->nbedges; e++)
-        side_count[m->bedge_side[e]]++;
-    for (size_t r = 0; r < nregions; r++)
-        surfaces += region_elements(m, tri_start, r) > 0;
-    size_t curves = 0;
-    for (int s = 0; s < GP_SIDE_COUNT; s++)
-        curves += side_count[s] > 0;
+/* The writer's state: the layout, and where the element list is. */
+typedef struct msh_state {
+    gp_mesh_layout layout;
+    size_t surfaces, curves;
+    uint64_t tag;       /* of the last element written */
+    int32_t region;     /* of the last triangle written */
+} msh_state;
 
+static void drop(void *state)
+{
+    gp_mesh_layout_free(&((msh_state *)state)->layout);
+}
+
+static int has_elements(gp_writer *w, size_t r)
+{
+    const msh_state *st = w->state;
+    return gp_mesh_layout_elements(&w->result->mesh, &st->layout, r) > 0;
+}
+
+/* The header and the sides' physical names; the regions' follow (region_name_item). */
+static void head(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    msh_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    if (gp_mesh_plan_check(w, o) || gp_mesh_layout_read(w, o, &st->layout))
+        return;
+    for (size_t r = 0; r <= m->ngrains; r++)
+        st->surfaces += has_elements(w, r);
+    for (int s = 0; s < GP_SIDE_COUNT; s++)
+        st->curves += st->layout.side_count[s] > 0;
     gp_out_puts(o, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n");
-    gp_out_uint(o, surfaces + curves);
+    gp_out_uint(o, st->surfaces + st->curves);
     gp_out_char(o, '\n');
     for (int s = 0; s < GP_SIDE_COUNT; s++) {
-        if (!side_count[s])
+        if (!st->layout.side_count[s])
             continue;
         gp_out_puts(o, "1 ");
         gp_out_int(o, s + 1);
@@ -169,45 +164,64 @@ int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
         gp_out_puts(o, gp_mesh_side_name((gp_mesh_side)s));
         gp_out_puts(o, "\"\n");
     }
-    for (size_t r = 0; r < nregions; r++) {
-        if (!region_elements(m, tri_start, r))
-            continue;
-        gp_out_puts(o, "2 ");
-        gp_out_int(o, surface_tag((int32_t)r));
-        gp_out_char(o, ' ');
-        region_name(o, m, (int32_t)r);
-        gp_out_char(o, '\n');
-    }
-    gp_out_puts(o, "$EndPhysicalNames\n$Entities\n0 ");
-    gp_out_uint(o, curves);
+}
+
+static void physical_name(gp_writer *w, gp_out *o, size_t r, int param)
+{
+    (void)param;
+    if (!has_elements(w, r))
+        return;
+    gp_out_puts(o, "2 ");
+    gp_out_int(o, surface_tag((int32_t)r));
     gp_out_char(o, ' ');
-    gp_out_uint(o, surfaces);
+    region_name(o, &w->result->mesh, (int32_t)r);
+    gp_out_char(o, '\n');
+}
+
+/* The entities' header and the sides' curves; the regions' surfaces follow. */
+static void entities(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    const msh_state *st = w->state;
+    gp_out_puts(o, "$EndPhysicalNames\n$Entities\n0 ");
+    gp_out_uint(o, st->curves);
+    gp_out_char(o, ' ');
+    gp_out_uint(o, st->surfaces);
     gp_out_puts(o, " 0\n");
     for (int s = 0; s < GP_SIDE_COUNT; s++) {
-        if (!side_count[s])
+        if (!st->layout.side_count[s])
             continue;
         gp_out_int(o, s + 1);
         gp_out_char(o, ' ');
-        bounding_box(o, &spec->domain);
+        bounding_box(o, &w->spec->domain);
         gp_out_puts(o, " 1 ");
         gp_out_int(o, s + 1);
         gp_out_puts(o, " 0\n");
     }
-    for (size_t r = 0; r < nregions; r++) {
-        if (!region_elements(m, tri_start, r))
-            continue;
-        gp_out_int(o, surface_tag((int32_t)r));
-        gp_out_char(o, ' ');
-        bounding_box(o, &spec->domain);
-        gp_out_puts(o, " 1 ");
-        gp_out_int(o, surface_tag((int32_t)r));
-        gp_out_puts(o, " 0\n");
-    }
-    /* every node in one block, on the first surface: elements refer to nodes by tag,
-       whatever entity holds them */
+}
+
+static void surface(gp_writer *w, gp_out *o, size_t r, int param)
+{
+    (void)param;
+    if (!has_elements(w, r))
+        return;
+    gp_out_int(o, surface_tag((int32_t)r));
+    gp_out_char(o, ' ');
+    bounding_box(o, &w->spec->domain);
+    gp_out_puts(o, " 1 ");
+    gp_out_int(o, surface_tag((int32_t)r));
+    gp_out_puts(o, " 0\n");
+}
+
+/* The nodes' header: every node in one block, on the first surface (elements refer to
+ * nodes by tag, whatever entity holds them). */
+static void nodes_head(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    const gp_mesh *m = &w->result->mesh;
     int64_t first = 1;
-    for (size_t r = 0; r < nregions; r++)
-        if (region_elements(m, tri_start, r)) {
+    for (size_t r = 0; r <= m->ngrains; r++)
+        if (has_elements(w, r)) {
             first = surface_tag((int32_t)r);
             break;
         }
@@ -220,19 +234,36 @@ int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
     gp_out_puts(o, " 0 ");
     gp_out_uint(o, m->nnodes);
     gp_out_char(o, '\n');
-    for (size_t k = 0; k < m->nnodes; k++) {
-        gp_out_uint(o, k + 1);
-        gp_out_char(o, '\n');
-    }
-    for (size_t k = 0; k < m->nnodes; k++) {
-        gp_out_double(o, m->xy[2 * k]);
-        gp_out_char(o, ' ');
-        gp_out_double(o, m->xy[2 * k + 1]);
-        gp_out_puts(o, " 0\n");
-    }
-    size_t blocks = curves + (m->nquad > 0), elements = m->nbedges + m->ntri + m->nquad;
-    for (size_t r = 0; r < nregions; r++)
-        blocks += tri_start[r + 1] > tri_start[r];
+}
+
+static void node_tag(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)w;
+    (void)param;
+    gp_out_uint(o, k + 1);
+    gp_out_char(o, '\n');
+}
+
+static void node_xy(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)param;
+    const double *xy = gp_writer_mesh(w, o, GP_MESH_XY, k);
+    if (!xy)
+        return;
+    gp_out_double(o, xy[0]);
+    gp_out_char(o, ' ');
+    gp_out_double(o, xy[1]);
+    gp_out_puts(o, " 0\n");
+}
+
+static void elements_head(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
+    const msh_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    size_t blocks = st->curves + (m->nquad > 0), elements = m->nbedges + m->ntri + m->nquad;
+    for (size_t r = 0; r <= m->ngrains; r++)
+        blocks += st->layout.tri_start[r + 1] > st->layout.tri_start[r];
     gp_out_puts(o, "$EndNodes\n$Elements\n");
     gp_out_uint(o, blocks);
     gp_out_char(o, ' ');
@@ -240,33 +271,93 @@ int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
     gp_out_puts(o, " 1 ");
     gp_out_uint(o, elements);
     gp_out_char(o, '\n');
-    uint64_t tag = 0;
-    int line_nodes = m->order + 1, tri_nodes = gp_mesh_tri_nodes(m->order);
-    for (int s = 0; s < GP_SIDE_COUNT; s++) {
-        if (!side_count[s])
-            continue;
-        element_block(o, 1, s + 1, m->order == 2 ? MSH_LINE3 : MSH_LINE2, side_count[s]);
-        for (size_t e = 0; e < m->nbedges; e++)
-            if (m->bedge_side[e] == s)
-                element(o, &tag, m->bedge + (size_t)line_nodes * e, line_nodes);
+}
+
+/* Boundary edge e if it is on side `side` (a pass per side, the side's block first). */
+static void side_edge(gp_writer *w, gp_out *o, size_t e, int side)
+{
+    msh_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    if (!st->layout.side_count[side])
+        return;
+    if (e == 0)
+        element_block(o, 1, side + 1, m->order == 2 ? MSH_LINE3 : MSH_LINE2, st->layout.side_count[side]);
+    const uint8_t *s = gp_writer_mesh(w, o, GP_MESH_BEDGE_SIDE, e);
+    if (!s || *s != side)
+        return;
+    const int32_t *nodes = gp_writer_mesh(w, o, GP_MESH_BEDGE, e);
+    if (nodes)
+        element(o, &st->tag, nodes, m->order + 1);
+}
+
+/* Triangle t, after its region's block header when it is the region's first. */
+static void triangle(gp_writer *w, gp_out *o, size_t t, int param)
+{
+    (void)param;
+    msh_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    const int32_t *region = gp_writer_mesh(w, o, GP_MESH_TRI_REGION, t);
+    if (!region)
+        return;
+    if (t == 0 || *region != st->region) {
+        st->region = *region;
+        size_t r = (size_t)*region;
+        element_block(o, 2, surface_tag(*region), m->order == 2 ? MSH_TRI6 : MSH_TRI3,
+                      st->layout.tri_start[r + 1] - st->layout.tri_start[r]);
     }
-    for (size_t r = 0; r < nregions; r++) {
-        size_t nt = tri_start[r + 1] - tri_start[r];
-        if (nt) {
-            element_block(o, 2, surface_tag((int32_t)r), m->order == 2 ? MSH_TRI6 : MSH_TRI3, nt);
-            for (size_t t = tri_start[r]; t < tri_start[r + 1]; t++)
-                element(o, &tag, m->tri + (size_t)tri_nodes * t, tri_nodes);
-        }
-        if (r == m->ngrains && m->nquad) {
-            int quad_nodes = gp_mesh_quad_nodes(m->order);
-            element_block(o, 2, surface_tag((int32_t)r), m->order == 2 ? MSH_QUAD8 : MSH_QUAD4, m->nquad);
-            for (size_t q = 0; q < m->nquad; q++)
-                element(o, &tag, m->quad + (size_t)quad_nodes * q, quad_nodes);
-        }
-    }
+    const int32_t *nodes = gp_writer_mesh(w, o, GP_MESH_TRI, t);
+    if (nodes)
+        element(o, &st->tag, nodes, gp_mesh_tri_nodes(m->order));
+}
+
+/* Quadrilateral q, all in the last region's block, after its triangles. */
+static void quad(gp_writer *w, gp_out *o, size_t q, int param)
+{
+    (void)param;
+    msh_state *st = w->state;
+    const gp_mesh *m = &w->result->mesh;
+    if (q == 0)
+        element_block(o, 2, surface_tag((int32_t)m->ngrains), m->order == 2 ? MSH_QUAD8 : MSH_QUAD4,
+                      m->nquad);
+    const int32_t *nodes = gp_writer_mesh(w, o, GP_MESH_QUAD, q);
+    if (nodes)
+        element(o, &st->tag, nodes, gp_mesh_quad_nodes(m->order));
+}
+
+static void tail(gp_writer *w, gp_out *o, int param)
+{
+    (void)param;
     gp_out_puts(o, "$EndElements\n");
-    free(tri_start);
-    int rc = periodic_section(o, &spec->domain, m);
-    int flushed = gp_out_flush(o);
-    return rc ? rc : flushed;
+    int rc = periodic_section(w, o);
+    if (rc && !o->err)
+        o->err = rc;
+}
+
+int gp_plan_msh(gp_writer *w)
+{
+    if (!(w->state = calloc(1, sizeof(msh_state))))
+        return GP_ENOMEM;
+    w->drop = drop;
+    const gp_mesh *m = &w->result->mesh;
+    size_t regions = w->result->has_mesh ? m->ngrains + 1 : 0;
+    gp_writer_text(w, head, 0);
+    gp_writer_items(w, physical_name, regions, 0);
+    gp_writer_text(w, entities, 0);
+    gp_writer_items(w, surface, regions, 0);
+    gp_writer_text(w, nodes_head, 0);
+    gp_writer_items(w, node_tag, m->nnodes, 0);
+    gp_writer_items(w, node_xy, m->nnodes, 0);
+    gp_writer_text(w, elements_head, 0);
+    for (int s = 0; s < GP_SIDE_COUNT; s++)
+        gp_writer_items(w, side_edge, m->nbedges, s);
+    gp_writer_items(w, triangle, m->ntri, 0);
+    gp_writer_items(w, quad, m->nquad, 0);
+    gp_writer_text(w, tail, 0);
+    return 0;
+}
+
+int gp_write_msh(gp_out *o, const gp_spec *spec, const gp_result *result)
+{
+    int checked = gp_mesh_result_check(result, GP_FORMAT_MSH, NULL);
+    return checked ? checked : gp_write_result(o, GP_FORMAT_MSH, spec, result);
 }

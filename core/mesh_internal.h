@@ -73,6 +73,29 @@ size_t gp_mesh_clip_box(const double *xy, size_t n, const double box[4], double 
  * 0 or GP_ENOMEM. */
 int gp_mesh_match_sides(gp_pslg *g, unsigned periodic, double W, double H, double tol);
 
+/* A node on a periodic side: its coordinate along the side, its index. */
+typedef struct gp_side_point {
+    double along;
+    int32_t point;
+} gp_side_point;
+
+/* The nodes on the two sides across `axis` of a periodic domain (coordinate 0 and the
+ * period), gathered window by window: what gp_mesh_periodic_pairs pairs, without the
+ * whole of the nodes at once (a download reads them through windows). */
+typedef struct gp_side_nodes {
+    int axis;
+    double period;
+    gp_side_point *lo, *hi;
+    size_t nlo, nhi, cap_lo, cap_hi;
+} gp_side_nodes;
+
+void gp_side_nodes_init(gp_side_nodes *s, const gp_domain *d, int axis);
+/* Adds nodes first .. first + n - 1 (xy: their 2 n coordinates). Returns 0 or GP_ENOMEM. */
+int gp_side_nodes_add(gp_side_nodes *s, const double *xy, size_t first, size_t n);
+/* The pairs, as gp_mesh_periodic_pairs returns them; frees what s gathered. */
+int gp_side_nodes_pairs(gp_side_nodes *s, int32_t **pairs, size_t *n);
+void gp_side_nodes_free(gp_side_nodes *s);
+
 /* Fills mesh->stats from the elements (angles, quality, areas) against the bound
  * `min_angle` (degrees) and the geometry's polygon areas. */
 void gp_mesh_compute_stats(gp_mesh *mesh, double min_angle, const gp_domain *domain,

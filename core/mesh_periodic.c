@@ -49,28 +49,24 @@ size_t gp_mesh_clip_box(const double *xy, size_t n, const double box[4], double 
     return m;
 }
 
-typedef struct side_point {
-    double along;
-    int32_t point;
-} side_point;
 
 static int by_along(const void *a, const void *b)
 {
-    double x = ((const side_point *)a)->along, y = ((const side_point *)b)->along;
+    double x = ((const gp_side_point *)a)->along, y = ((const gp_side_point *)b)->along;
     return (x > y) - (x < y);
 }
 
 /* The points on the line where coordinate `axis` is c, sorted along it; *n gets how
  * many. NULL when out of memory. */
-static side_point *on_line(const gp_pslg *g, int axis, double c, size_t *n)
+static gp_side_point *on_line(const gp_pslg *g, int axis, double c, size_t *n)
 {
-    side_point *list = malloc((g->npoints ? g->npoints : 1) * sizeof *list);
+    gp_side_point *list = malloc((g->npoints ? g->npoints : 1) * sizeof *list);
     *n = 0;
     if (!list)
         return NULL;
     for (size_t k = 0; k < g->npoints; k++)
         if (g->xy[2 * k + axis] == c)
-            list[(*n)++] = (side_point){g->xy[2 * k + 1 - axis], (int32_t)k};
+            list[(*n)++] = (gp_side_point){g->xy[2 * k + 1 - axis], (int32_t)k};
     qsort(list, *n, sizeof *list, by_along);
     return list;
 }
@@ -81,7 +77,7 @@ static side_point *on_line(const gp_pslg *g, int axis, double c, size_t *n)
 static int match_axis(gp_pslg *g, int axis, double period, double tol)
 {
     size_t nlo, nhi;
-    side_point *lo = on_line(g, axis, 0.0, &nlo), *hi = on_line(g, axis, period, &nhi);
+    gp_side_point *lo = on_line(g, axis, 0.0, &nlo), *hi = on_line(g, axis, period, &nhi);
     int rc = lo && hi ? 0 : GP_ENOMEM;
     size_t i = 0, j = 0;
     while (rc == 0 && (i < nlo || j < nhi)) {
@@ -117,30 +113,42 @@ int gp_mesh_match_sides(gp_pslg *g, unsigned periodic, double W, double H, doubl
     return rc;
 }
 
-int gp_mesh_periodic_pairs(const gp_mesh *m, const gp_domain *d, int axis, int32_t **pairs,
-                           size_t *n)
+void gp_side_nodes_init(gp_side_nodes *s, const gp_domain *d, int axis)
+{
+    memset(s, 0, sizeof *s);
+    s->axis = axis;
+    s->period = axis == 0 ? d->width : d->height;
+}
+
+static int add_side_point(gp_side_point **list, size_t *n, size_t *cap, double along, size_t k)
+{
+    if (gp_mesh_reserve((void **)list, cap, *n + 1, sizeof **list))
+        return GP_ENOMEM;
+    (*list)[(*n)++] = (gp_side_point){along, (int32_t)k};
+    return 0;
+}
+
+int gp_side_nodes_add(gp_side_nodes *s, const double *xy, size_t first, size_t n)
+{
+    for (size_t j = 0; j < n; j++) {
+        double c = xy[2 * j + s->axis], along = xy[2 * j + 1 - s->axis];
+        int rc = 0;
+        if (c == 0.0)
+            rc = add_side_point(&s->lo, &s->nlo, &s->cap_lo, along, first + j);
+        else if (c == s->period)
+            rc = add_side_point(&s->hi, &s->nhi, &s->cap_hi, along, first + j);
+        if (rc)
+            return rc;
+    }
+    return 0;
+}
+
+int gp_side_nodes_pairs(gp_side_nodes *s, int32_t **pairs, size_t *n)
 {
     *pairs = NULL;
     *n = 0;
-    unsigned bit = axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y;
-    if (!(d->periodic & bit))
-        return 0;
-    double period = axis == 0 ? d->width : d->height;
-    side_point *lo = malloc((m->nnodes ? m->nnodes : 1) * sizeof *lo);
-    side_point *hi = malloc((m->nnodes ? m->nnodes : 1) * sizeof *hi);
-    size_t nlo = 0, nhi = 0;
-    if (!lo || !hi) {
-        free(lo);
-        free(hi);
-        return GP_ENOMEM;
-    }
-    for (size_t k = 0; k < m->nnodes; k++) {
-        double c = m->xy[2 * k + axis], along = m->xy[2 * k + 1 - axis];
-        if (c == 0.0)
-            lo[nlo++] = (side_point){along, (int32_t)k};
-        else if (c == period)
-            hi[nhi++] = (side_point){along, (int32_t)k};
-    }
+    gp_side_point *lo = s->lo, *hi = s->hi;
+    size_t nlo = s->nlo, nhi = s->nhi;
     qsort(lo, nlo, sizeof *lo, by_along);
     qsort(hi, nhi, sizeof *hi, by_along);
     int rc = nlo == nhi ? 0 : GP_EGEOM;
@@ -155,7 +163,32 @@ int gp_mesh_periodic_pairs(const gp_mesh *m, const gp_domain *d, int axis, int32
     }
     if (rc == 0)
         *n = nlo;
-    free(lo);
-    free(hi);
+    gp_side_nodes_free(s);
     return rc;
+}
+
+void gp_side_nodes_free(gp_side_nodes *s)
+{
+    free(s->lo);
+    free(s->hi);
+    s->lo = s->hi = NULL;
+    s->nlo = s->nhi = s->cap_lo = s->cap_hi = 0;
+}
+
+int gp_mesh_periodic_pairs(const gp_mesh *m, const gp_domain *d, int axis, int32_t **pairs,
+                           size_t *n)
+{
+    *pairs = NULL;
+    *n = 0;
+    unsigned bit = axis == 0 ? GP_PERIODIC_X : GP_PERIODIC_Y;
+    if (!(d->periodic & bit))
+        return 0;
+    gp_side_nodes s;
+    gp_side_nodes_init(&s, d, axis);
+    int rc = gp_side_nodes_add(&s, m->xy, 0, m->nnodes);
+    if (rc) {
+        gp_side_nodes_free(&s);
+        return rc;
+    }
+    return gp_side_nodes_pairs(&s, pairs, n);
 }

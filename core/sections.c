@@ -1,6 +1,7 @@
 /* sections.c - a result cut into tagged binary sections and read back: the summary
  * decoded whole, the per-grain arrays window by window (sections.h has the layouts). */
 #include "sections.h"
+#include "mesh_source.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,7 +15,8 @@
 _Static_assert(sizeof(gp_disk) == 32, "a disk is stored as four doubles");
 _Static_assert(sizeof(gp_sphere) == 40, "a sphere is stored as five doubles");
 
-/* The version of every section's layout this build writes (and the only one it reads). */
+/* The version of every section's layout this build writes (and the only one it reads),
+ * but the mesh summary's (GP_SECTION_MESH_VERSION). */
 #define LAYOUT_V1 1
 
 /* --- encoding --- */
@@ -280,6 +282,7 @@ int gp_sections_from_result(const gp_result *r, gp_section *s, size_t *n)
         if (e.failed)
             goto fail;
         add(s, n, GP_SECTION_MESH, 1, NULL, 0, &e);
+        s[*n - 1].version = GP_SECTION_MESH_VERSION;
         add(s, n, GP_SECTION_MESH_XY, 0, m->xy, 2 * m->nnodes * sizeof(double), NULL);
         add(s, n, GP_SECTION_MESH_TRI, 0, m->tri,
             m->ntri * (size_t)gp_mesh_tri_nodes(m->order) * sizeof(int32_t), NULL);
@@ -290,6 +293,14 @@ int gp_sections_from_result(const gp_result *r, gp_section *s, size_t *n)
         add(s, n, GP_SECTION_MESH_BEDGE, 0, m->bedge,
             m->nbedges * (size_t)(m->order + 1) * sizeof(int32_t), NULL);
         add(s, n, GP_SECTION_MESH_BEDGE_SIDE, 0, m->bedge_side, m->nbedges, NULL);
+        /* the elements' qualities, which need their nodes: a download reads the nodes
+           window by window, not the ones an element happens to use */
+        e = (enc){0};
+        for (size_t k = 0; k < m->ntri + m->nquad && !e.failed; k++)
+            put_f64(&e, gp_mesh_quality_at(m, k));
+        if (e.failed)
+            goto fail;
+        add(s, n, GP_SECTION_MESH_QUALITY, 0, NULL, 0, &e);
     }
     return 0;
 fail:
@@ -547,7 +558,8 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
         decode = decode_mesh;
     if (!decode)
         return 0;
-    if (version != LAYOUT_V1)
+    /* the mesh summary's layout is the same in both its versions */
+    if (version != LAYOUT_V1 && !(decode == decode_mesh && version == GP_SECTION_MESH_VERSION))
         return GP_EINVAL;
     dec d = {data, size, 0};
     int rc = decode(&d, summary);
@@ -790,6 +802,9 @@ int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx
                 rc = GP_EPARSE;
                 break;
             }
+    for (size_t i = 0; i < m->nbedges && rc == 0; i++)
+        if (((const uint8_t *)p[6])[i] >= GP_SIDE_COUNT)
+            rc = GP_EPARSE;
     if (rc) {
     fail:
         for (int i = 0; i < 7; i++)
@@ -882,4 +897,92 @@ void gp_summary3d_free(gp_summary3d *summary)
 {
     gp_pack3d_stats_free(&summary->stats);
     memset(summary, 0, sizeof *summary);
+}
+
+/* --- the mesh, window by window --- */
+
+static const char *const mesh_tags[GP_MESH_ARRAYS] = {
+    GP_SECTION_MESH_XY, GP_SECTION_MESH_TRI, GP_SECTION_MESH_TRI_REGION, GP_SECTION_MESH_QUAD,
+    GP_SECTION_MESH_QUAD_REGION, GP_SECTION_MESH_BEDGE, GP_SECTION_MESH_BEDGE_SIDE,
+    GP_SECTION_MESH_QUALITY,
+};
+
+typedef struct sections_mesh {
+    const gp_mesh *m;            /* the summary's: counts and order */
+    gp_section_read_fn read;
+    void *ctx;
+    size_t window;
+    int quality;                 /* the qualities are stored */
+    void *buf[GP_MESH_ARRAYS];   /* `window` records of each array */
+} sections_mesh;
+
+/* Whether n records of array `a` hold node indices, regions and sides in range: a
+ * corrupt store must not make a writer read out of bounds. */
+static int in_range(const gp_mesh *m, gp_mesh_array a, const void *data, size_t n)
+{
+    size_t values = n * gp_mesh_record_size(m, a), limit;
+    switch (a) {
+    case GP_MESH_TRI:
+    case GP_MESH_QUAD:
+    case GP_MESH_BEDGE: limit = m->nnodes; values /= sizeof(int32_t); break;
+    case GP_MESH_TRI_REGION:
+    case GP_MESH_QUAD_REGION: limit = m->ngrains + 1; values /= sizeof(int32_t); break;
+    case GP_MESH_BEDGE_SIDE:
+        for (size_t k = 0; k < n; k++)
+            if (((const uint8_t *)data)[k] >= GP_SIDE_COUNT)
+                return 0;
+        return 1;
+    default: return 1;
+    }
+    const int32_t *v = data;
+    for (size_t k = 0; k < values; k++)
+        if (v[k] < 0 || (size_t)v[k] >= limit)
+            return 0;
+    return 1;
+}
+
+static int load_mesh(void *ctx, gp_mesh_array a, size_t first, const void **data, size_t *count)
+{
+    sections_mesh *s = ctx;
+    if (a == GP_MESH_QUALITY && !s->quality)
+        return GP_EINVAL;
+    size_t total = gp_mesh_record_count(s->m, a), size = gp_mesh_record_size(s->m, a);
+    if (first >= total)
+        return GP_EINVAL;
+    size_t n = total - first < s->window ? total - first : s->window;
+    int rc = s->read(s->ctx, mesh_tags[a], (uint64_t)first * size, s->buf[a], n * size);
+    if (rc)
+        return rc;
+    if (!in_range(s->m, a, s->buf[a], n))
+        return GP_EPARSE;
+    *data = s->buf[a];
+    *count = n;
+    return 0;
+}
+
+static void drop_mesh(void *ctx)
+{
+    sections_mesh *s = ctx;
+    for (int a = 0; a < GP_MESH_ARRAYS; a++)
+        free(s->buf[a]);
+    free(s);
+}
+
+int gp_sections_mesh_source(const gp_result *summary, gp_section_read_fn read, void *ctx,
+                            size_t window, int quality, gp_mesh_source *out)
+{
+    if (!summary->has_mesh)
+        return GP_EINVAL;
+    sections_mesh *s = calloc(1, sizeof *s);
+    if (!s)
+        return GP_ENOMEM;
+    *s = (sections_mesh){&summary->mesh, read, ctx, window ? window : GP_MESH_WINDOW_RECORDS, quality,
+                         {NULL}};
+    for (int a = 0; a < GP_MESH_ARRAYS; a++)
+        if (!(s->buf[a] = malloc(s->window * gp_mesh_record_size(s->m, (gp_mesh_array)a)))) {
+            drop_mesh(s);
+            return GP_ENOMEM;
+        }
+    *out = (gp_mesh_source){load_mesh, s, drop_mesh};
+    return 0;
 }

@@ -2,7 +2,8 @@
  * each stage produced, each section named by a tag, with the version of its layout, so
  * that a reader skips tags it does not know and a later stage (a mesh) adds its own.
  *
- * Tags and layouts (version 1; little-endian; f64 = IEEE double, u32/u64/i32 integers):
+ * Tags and layouts (version 1 but "mesh"; little-endian; f64 = IEEE double, u32/u64/i32
+ * integers):
  *   "pack"            the packing's diagnostics (with the front's rule and, for the waiting
  *                     rule, wait_levels and alive_quantile) and statistics (gp_pack_stats,
  *                     with its bins)
@@ -17,7 +18,10 @@
  *   "cell_neighbours" per neighbour: its grain id (i32), cell after cell
  *   "mesh"            the mesh's summary: kind, order, counts, each region's polygon area,
  *                     gp_mesh_stats (its periodic node pairs and rounds last: a summary
- *                     stored before them ends without, and reads as 0)
+ *                     stored before them ends without, and reads as 0). Version 2
+ *                     (GP_SECTION_MESH_VERSION) has the layout of version 1 and says that
+ *                     "mesh_quality" is stored: a reader lists only the summary sections,
+ *                     so the version is where it learns it
  *   "mesh_xy"         per node: x, y (f64 each)
  *   "mesh_tri"        per triangle: its 3 (order 1) or 6 (order 2) node indices (i32)
  *   "mesh_tri_region" per triangle: its region (i32)
@@ -25,6 +29,10 @@
  *   "mesh_quad_region" per quadrilateral: its region (i32)
  *   "mesh_bedge"      per boundary edge: its order + 1 node indices (i32)
  *   "mesh_bedge_side" per boundary edge: its gp_mesh_side (u8)
+ *   "mesh_quality"    per element, triangles then quadrilaterals: its quality (f64,
+ *                     gp_mesh_element_quality); stored with "mesh" version 2, since meshes
+ *                     are downloaded window by window (a result stored before has none: a
+ *                     vtu download then reads its mesh whole)
  * The 3D process (pack3d, docs/3d.md) stores:
  *   "pack3d"          the box, the front's counters (spheres, wall spheres, triangles,
  *                     attempts, max level, fill volume) and the statistics of the spheres
@@ -70,12 +78,16 @@ extern "C" {
 #define GP_SECTION_MESH_QUAD_REGION "mesh_quad_region"
 #define GP_SECTION_MESH_BEDGE "mesh_bedge"
 #define GP_SECTION_MESH_BEDGE_SIDE "mesh_bedge_side"
+#define GP_SECTION_MESH_QUALITY "mesh_quality"
+
+/* The version of the "mesh" section this build writes: 2, its qualities stored. */
+#define GP_SECTION_MESH_VERSION 2
 #define GP_SECTION_PACK3D "pack3d"
 #define GP_SECTION_SPHERES "spheres"
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24
-/* The most sections a result has today: 9 for the grains, 8 for the mesh, and room for a
+/* The most sections a result has today: 9 for the grains, 9 for the mesh, and room for a
  * few more. */
 #define GP_SECTIONS_MAX 24
 
@@ -111,11 +123,21 @@ int gp_section_decode_summary(const char *tag, uint32_t version, const void *dat
 typedef int (*gp_section_read_fn)(void *ctx, const char *tag, uint64_t offset, void *dst,
                                   size_t len);
 
-/* Reads the mesh's arrays whole (the mesh formats are not written window by window)
- * into summary->mesh, whose counts the "mesh" section set; nothing when they are read
+/* Reads the mesh's arrays whole (for the SVG picture's edges, a mesh under its cap, and
+ * a vtu of a result stored without its qualities) into summary->mesh, whose counts the "mesh" section set; nothing when they are read
  * already. Returns 0, GP_EINVAL (no mesh), GP_ENOMEM, the reader's error, or GP_EPARSE
  * when a node index or a region is out of range. What it reads is owned by `summary`. */
 int gp_sections_read_mesh(gp_result *summary, gp_section_read_fn read, void *ctx);
+
+/* The mesh of a stored result (summary->has_mesh), read through `read` (ctx is its
+ * argument) `window` records of each array at a time (0: GP_MESH_WINDOW_RECORDS), node
+ * indices, regions and sides checked as they are read (GP_EPARSE). `quality`: whether the
+ * result has the "mesh_quality" section (without it, loading the qualities fails with
+ * GP_EINVAL). `summary` is borrowed and must outlive the source. Returns 0, GP_EINVAL (no
+ * mesh) or GP_ENOMEM; free with gp_mesh_source_free. */
+struct gp_mesh_source;
+int gp_sections_mesh_source(const gp_result *summary, gp_section_read_fn read, void *ctx,
+                            size_t window, int quality, struct gp_mesh_source *out);
 
 /* Grains a window of a stored result holds: the buffers then take about 300 bytes a
  * grain (disks, F, area, a cell's six or so vertices), some 300 KB. */

@@ -8,6 +8,8 @@
 #include <zlib.h>
 
 #include "sections.h"
+#include "io_svg_mesh.h"
+#include "mesh_source.h"
 #include "log.h"
 #include "render.h"
 
@@ -29,8 +31,7 @@ typedef struct gp_download {
     gp_format format;
     gp_result_reader *reader;
     gp_sections_source *source;
-    gp_sections_source *whole; /* VTU's grains, read in one window (io_mesh_plan.c) */
-    int loaded;                /* what the mesh formats read whole is in res.summary */
+    int loaded;                /* load_mesh ran */
     gp_writer *writer;
     gp_download_renderer renderer; /* instead of writer, for another process's result */
     const char *name;              /* of the format, for the log */
@@ -48,38 +49,34 @@ static int read_section(void *ctx, const char *tag, uint64_t offset, void *dst, 
     return d->db ? gp_result_reader_read(d->reader, d->db, tag, offset, dst, len) : GP_SRV_EDB;
 }
 
-/* The mesh formats read the result whole, not window by window: the mesh's arrays
- * (msh, inp, vtu, and svg which draws the edges) and, for vtu, the grains' arrays, lent
- * to the summary from one window over all grains (taken back in release). Returns 0 or
- * the reader's error. */
-static int load_whole(gp_download *d)
+/* Sets up what a format reads besides the per-grain windows. The mesh formats read the
+ * mesh window by window (msh, inp, vtu), but for a vtu of a result stored before the
+ * elements' qualities were (they need each element's nodes: the mesh is then read whole,
+ * as it used to be), and the SVG picture draws the edges of a mesh under its cap (read
+ * whole: some ten megabytes at most), nothing beyond. Returns 0 or the reader's error. */
+static int load_mesh(gp_download *d)
 {
     gp_result *r = &d->res.summary;
-    int rc = 0;
+    int rc;
     if (r->has_mesh && (d->format == GP_FORMAT_MSH || d->format == GP_FORMAT_INP ||
-                        d->format == GP_FORMAT_VTU || d->format == GP_FORMAT_SVG))
-        rc = gp_sections_read_mesh(r, read_section, d);
-    if (rc == 0 && d->format == GP_FORMAT_VTU && r->packing.count > 0) {
-        if (!(d->whole = gp_sections_source_new(r, read_section, d, r->packing.count)))
-            return GP_ENOMEM;
-        unsigned needs = GP_GRAINS_DISKS | (r->has_balance ? GP_GRAINS_F : 0) |
-                         (r->has_cells ? GP_GRAINS_AREA | GP_GRAINS_POLYGONS | GP_GRAINS_NEIGHBOURS : 0);
-        gp_grain_source g = gp_sections_source_grains(d->whole);
-        gp_grain_window win;
-        if ((rc = g.load(g.ctx, needs, 0, &win)))
+                        (d->format == GP_FORMAT_VTU && d->res.mesh_quality))) {
+        gp_mesh_source src;
+        if ((rc = gp_sections_mesh_source(r, read_section, d, 0, d->res.mesh_quality, &src)))
             return rc;
-        r->packing.disks = (gp_disk *)win.disks;
-        if (r->has_balance)
-            r->balance.F = (double *)win.F;
-        if (r->has_cells) {
-            r->cells.area = (double *)win.area;
-            r->cells.start = (size_t *)win.start;
-            r->cells.xy = (double *)win.xy;
-            r->cells.nstart = (size_t *)win.nstart;
-            r->cells.neighbours = (int32_t *)win.neighbours;
-        }
+        gp_writer_set_mesh(d->writer, &src);
+        return 0;
     }
-    return rc;
+    if (r->has_mesh && d->format == GP_FORMAT_VTU) {
+        gp_mesh_source src;
+        if ((rc = gp_sections_read_mesh(r, read_section, d)) ||
+            (rc = gp_mesh_source_memory(&r->mesh, &src)))
+            return rc;
+        gp_writer_set_mesh(d->writer, &src);
+        return 0;
+    }
+    if (r->has_mesh && d->format == GP_FORMAT_SVG && gp_svg_mesh_drawable(&r->mesh))
+        return gp_sections_read_mesh(r, read_section, d);
+    return 0;
 }
 
 /* Renders on until `text` holds `want` bytes or the writer is done. Returns 0 or the
@@ -97,7 +94,7 @@ static int render(gp_download *d, size_t want)
         rc = d->renderer.run(d->renderer.ctx, read_section, d, &d->text, want);
     } else {
         if (!d->loaded) {
-            rc = load_whole(d);
+            rc = load_mesh(d);
             d->loaded = rc == 0;
         }
         if (rc == 0)
@@ -179,15 +176,6 @@ static void release(gp_body_stream *s)
     if (d->renderer.free)
         d->renderer.free(d->renderer.ctx);
     gp_sections_source_free(d->source);
-    if (d->whole) { /* the grains lent to the summary are the window's */
-        gp_result *r = &d->res.summary;
-        r->packing.disks = NULL;
-        r->balance.F = NULL;
-        r->cells.area = r->cells.xy = NULL;
-        r->cells.start = r->cells.nstart = NULL;
-        r->cells.neighbours = NULL;
-    }
-    gp_sections_source_free(d->whole);
     gp_result_reader_free(d->reader);
     gp_out_free(&d->text);
     gp_stored_result_free(&d->res);

@@ -260,6 +260,7 @@ typedef struct gp_stored_result {
                                         a process that decodes its own (processes.h) */
     size_t nraw;
     char version[40];       /* changes whenever the stored bytes could (a strong ETag's root) */
+    int mesh_quality;       /* the mesh's qualities are stored (sections.h: "mesh" version 2) */
 } gp_stored_result;
 
 /* Opens the result of a successful job of `owner`: reads the spec and the summary

@@ -74,9 +74,11 @@ int gp_store_sqlite_open(const char *path, gp_store **out, char *why, size_t why
 int gp_store_pg_open(const char *uri, gp_store **out, char *why, size_t why_size);
 
 /* Decodes the summary sections refs[0..n) of job `id` (read whole through read_chunk)
- * into res->summary (a 2D result's; other tags are skipped) and keeps each as stored in
- * res->raw. Returns 0, GP_SRV_ENOTFOUND (a section is missing, or none: the job was
- * deleted meanwhile), GP_SRV_EDB (a section that cannot be decoded: logged) or
+ * into res->summary (a 2D result's; other tags are skipped), keeps each as stored in
+ * res->raw, and notes in res->mesh_quality whether the mesh's qualities are stored (its
+ * "mesh" section's version says so: a result stored before has none). Returns 0,
+ * GP_SRV_ENOTFOUND (a section is missing, or none: the job was deleted meanwhile),
+ * GP_SRV_EDB (a section that cannot be decoded: logged) or
  * GP_ENOMEM. */
 int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *refs, size_t n,
                             gp_stored_result *res);

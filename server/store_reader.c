@@ -66,6 +66,8 @@ int gp_store_decode_summary(gp_db *db, const char *id, const gp_section_ref *ref
         raw->summary = 1;
         raw->data = raw->owned = bytes;
         raw->size = (size_t)refs[i].bytes;
+        res->mesh_quality |= strcmp(refs[i].tag, GP_SECTION_MESH) == 0 &&
+                             refs[i].version == GP_SECTION_MESH_VERSION;
     }
     return 0;
 }

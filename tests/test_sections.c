@@ -11,6 +11,7 @@
 #include "grainpack/pipeline3d.h"
 #include "json_values.h"
 #include "sections.h"
+#include "mesh_source.h"
 #include "packing_checks.h"
 #include "render_checks.h"
 
@@ -73,13 +74,19 @@ static int decode(stored *st, gp_result *summary)
     return 0;
 }
 
-/* Writes through the sections, `step` bytes at a time (SIZE_MAX: at once). */
+/* Writes through the sections, `step` bytes at a time (SIZE_MAX: at once); the mesh
+ * formats read the mesh through windows of `window` records too. */
 static char *render_stored(gp_format f, const gp_spec *spec, const gp_result *summary, stored *st,
                            size_t window, size_t step, size_t *len)
 {
     gp_sections_source *src = gp_sections_source_new(summary, read_stored, st, window);
     gp_grain_source g = gp_sections_source_grains(src);
     gp_writer *w = gp_writer_new(f, spec, summary, &g);
+    if (summary->has_mesh && (gp_format_needs_mesh(f) || f == GP_FORMAT_VTU)) {
+        gp_mesh_source mesh;
+        CHECK(gp_sections_mesh_source(summary, read_stored, st, window, 1, &mesh) == 0);
+        gp_writer_set_mesh(w, &mesh);
+    }
     gp_out out;
     CHECK(gp_out_init(&out, 0, NULL, NULL) == 0);
     int rc;
@@ -87,9 +94,10 @@ static char *render_stored(gp_format f, const gp_spec *spec, const gp_result *su
     while ((rc = gp_writer_run(w, &out, step == SIZE_MAX ? SIZE_MAX : out.len + step)) == 1)
         calls++;
     CHECK(rc == 0);
-    /* the mesh is written in whole text steps (io_mesh_plan.c, the SVG's edges): a mesh's
-     * formats stop fewer times */
-    CHECK(step == SIZE_MAX || calls > 10 || summary->has_mesh);
+    /* stopped every `step` bytes or so (a grain or an item past it): between two grains or items (the SVG's mesh edges
+     * are one text step, which stops fewer times) */
+    CHECK_MSG(step == SIZE_MAX || calls + 1 >= out.len / (2 * step) || (summary->has_mesh && f == GP_FORMAT_SVG),
+              "%s: %zu stops in %zu bytes", gp_format_name(f), calls, out.len);
     gp_writer_free(w);
     gp_sections_source_free(src);
     gp_out_char(&out, '\0');
@@ -114,20 +122,21 @@ static void check_every_format(const char *label, const gp_spec *spec, const gp_
         CHECK(summary.cell_stats.vertices == r->cells.start[r->cells.count] &&
               summary.cell_stats.max_neighbours == r->cell_stats.max_neighbours &&
               summary.cell_stats.band_fraction == r->cell_stats.band_fraction);
-    if (r->has_mesh) {
+    if (r->has_mesh)
         CHECK(summary.has_mesh && summary.mesh.stats.triangles == r->mesh.stats.triangles &&
               summary.mesh.xy == NULL);
-        CHECK(gp_sections_read_mesh(&summary, read_stored, &st) == 0);
-        CHECK(summary.mesh.nnodes == r->mesh.nnodes &&
-              memcmp(summary.mesh.xy, r->mesh.xy, 2 * r->mesh.nnodes * sizeof(double)) == 0);
-    }
-    /* windows of 7 grains: cells straddle every kind of boundary; 1024: the default */
+    /* windows of 7 grains or mesh records: cells and regions straddle every kind of
+     * boundary; 0: the defaults */
     const size_t windows[] = {7, 0};
     for (int f = 0; f < (int)gp_format_count(); f++) {
-        /* msh and inp exist only with a mesh; vtu reads the grains whole, which only the
-         * service's download lends it (test_service_mesh compares its bytes) */
-        if ((gp_format_needs_mesh((gp_format)f) && !r->has_mesh) || f == GP_FORMAT_VTU)
+        /* msh and inp exist only with a mesh; the mesh's SVG draws it read whole */
+        if (gp_format_needs_mesh((gp_format)f) && !r->has_mesh)
             continue;
+        if (f == GP_FORMAT_SVG && r->has_mesh && !summary.mesh.xy) {
+            CHECK(gp_sections_read_mesh(&summary, read_stored, &st) == 0);
+            CHECK(summary.mesh.nnodes == r->mesh.nnodes &&
+                  memcmp(summary.mesh.xy, r->mesh.xy, 2 * r->mesh.nnodes * sizeof(double)) == 0);
+        }
         size_t len;
         char *want = render_text((gp_format)f, spec, r, &len);
         for (size_t k = 0; k < 2; k++) {
@@ -173,39 +182,133 @@ static void test_every_format_reads_the_same_from_sections(void)
     }
 }
 
-/* A mesh (grains and band, quadrilateral layers, order 2) through its sections: the
- * summary, the arrays read whole, and every format but vtu from them. */
+/* Runs the pipeline on spec text `json` (0, or its failure reported). */
+static int run_json(const char *json, gp_spec *spec, gp_result *r)
+{
+    gp_error err;
+    int rc = gp_spec_parse(json, strlen(json), NULL, spec, &err);
+    CHECK_MSG(rc == 0, "%s", err.message);
+    if (rc)
+        return rc;
+    rc = gp_pipeline_run(spec, 0, NULL, r, &err);
+    CHECK_MSG(rc == 0, "%s", err.message);
+    if (rc)
+        gp_spec_free(spec);
+    return rc;
+}
+
+/* Runs writer `f` of the stored `st` to its end, the mesh read through `window` records
+ * with or without the stored qualities: its return code. */
+static int run_mesh_writer(gp_format f, const gp_spec *spec, const gp_result *summary, stored *st,
+                           size_t window, int quality)
+{
+    gp_sections_source *src = gp_sections_source_new(summary, read_stored, st, window);
+    gp_grain_source g = gp_sections_source_grains(src);
+    gp_writer *w = gp_writer_new(f, spec, summary, &g);
+    gp_mesh_source mesh;
+    CHECK(gp_sections_mesh_source(summary, read_stored, st, window, quality, &mesh) == 0);
+    gp_writer_set_mesh(w, &mesh);
+    gp_out out;
+    gp_out_init(&out, 0, NULL, NULL);
+    int rc = gp_writer_run(w, &out, SIZE_MAX);
+    gp_out_free(&out);
+    gp_writer_free(w);
+    gp_sections_source_free(src);
+    return rc;
+}
+
+/* Meshes through their sections (grains and band with quadrilateral layers at order 2,
+ * triangles only, shrink none, disks in a matrix, a periodic one): the summary, and every
+ * format read window by window from them gives the bytes of the mesh in memory. */
 static void test_mesh_from_sections(void)
+{
+    const char *base = "{\"domain\": {\"width\": 20, \"height\": 20}, \"distribution\": {\"kind\": "
+                       "\"uniform\", \"min\": 0.5, \"max\": 1.5}, \"joint\": {\"law\": \"constant\", "
+                       "\"value\": 0.1}";
+    const struct {
+        const char *label, *rest;
+    } cases[] = {
+        {"layers order 2", ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {\"band_layers\": 2, \"order\": 2}}"},
+        {"triangles", ", \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {}}"},
+        {"shrink none", ", \"laguerre\": {\"shrink\": \"none\"}, \"mesh\": {\"order\": 2}}"},
+        {"matrix", ", \"mesh\": {}}"},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        char json[1024];
+        snprintf(json, sizeof json, "%s%s", base, cases[c].rest);
+        gp_spec spec;
+        gp_result r;
+        if (run_json(json, &spec, &r))
+            continue;
+        CHECK(r.has_mesh && (c > 0 || r.mesh.nquad > 0));
+        check_every_format(cases[c].label, &spec, &r);
+        gp_result_free(&r);
+        gp_spec_free(&spec);
+    }
+    /* a periodic domain: the $Periodic section and the paired node sets from the windows */
+    const char *periodic = "{\"domain\": {\"width\": 16, \"height\": 16, \"periodic\": true}, "
+                           "\"distribution\": {\"kind\": \"uniform\", \"min\": 0.5, \"max\": 1.0}, "
+                           "\"joint\": {\"law\": \"constant\", \"value\": 0.1}, \"laguerre\": "
+                           "{\"shrink\": \"offset\"}, \"mesh\": {}}";
+    gp_spec spec;
+    gp_result r;
+    if (run_json(periodic, &spec, &r) == 0) {
+        CHECK(r.mesh.stats.periodic_pairs[0] > 2);
+        check_every_format("periodic", &spec, &r);
+        gp_result_free(&r);
+        gp_spec_free(&spec);
+    }
+}
+
+/* A stored mesh that is corrupt (a node index beyond the nodes, a side that is none) is
+ * refused, not handed to a writer; a result stored without the qualities writes msh and
+ * inp from its windows but not vtu (the download reads that mesh whole). */
+static void test_mesh_sections_refused(void)
 {
     const char *json = "{\"domain\": {\"width\": 20, \"height\": 20}, \"distribution\": {\"kind\": "
                        "\"uniform\", \"min\": 0.5, \"max\": 1.5}, \"joint\": {\"law\": \"constant\", "
-                       "\"value\": 0.1}, \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": "
-                       "{\"band_layers\": 2, \"order\": 2}}";
+                       "\"value\": 0.1}, \"laguerre\": {\"shrink\": \"offset\"}, \"mesh\": {}}";
     gp_spec spec;
     gp_result r;
-    gp_error err;
-    int rc = gp_spec_parse(json, strlen(json), NULL, &spec, &err);
-    CHECK_MSG(rc == 0, "%s", err.message);
-    if (rc)
+    if (run_json(json, &spec, &r))
         return;
-    rc = gp_pipeline_run(&spec, 0, NULL, &r, &err);
-    CHECK_MSG(rc == 0, "%s", err.message);
-    if (rc) {
-        gp_spec_free(&spec);
-        return;
+    const char *tags[] = {GP_SECTION_MESH_TRI, GP_SECTION_MESH_BEDGE_SIDE, GP_SECTION_MESH_TRI_REGION};
+    for (size_t t = 0; t < 3; t++) {
+        stored st;
+        store(&st, &r);
+        for (size_t i = 0; i < st.n; i++)
+            if (strcmp(st.sections[i].tag, tags[t]) == 0)
+                memset(st.copy[i] + st.sections[i].size - 4, 0x7f, 4);
+        gp_result summary;
+        CHECK(decode(&st, &summary) == 0);
+        CHECK(gp_sections_read_mesh(&summary, read_stored, &st) == GP_EPARSE && summary.mesh.xy == NULL);
+        /* (vtu has no use for the sides) */
+        for (gp_format f = GP_FORMAT_MSH; f <= (t == 1 ? GP_FORMAT_INP : GP_FORMAT_VTU); f++)
+            CHECK_MSG(run_mesh_writer(f, &spec, &summary, &st, 5, 1) == GP_EPARSE, "%s with a corrupt %s",
+                      gp_format_name(f), tags[t]);
+        gp_result_free(&summary);
+        unstore(&st);
     }
-    CHECK(r.has_mesh && r.mesh.nquad > 0);
-    check_every_format("mesh", &spec, &r);
-    /* a node index beyond the nodes is refused, not handed to a writer */
     stored st;
     store(&st, &r);
-    for (size_t i = 0; i < st.n; i++)
-        if (strcmp(st.sections[i].tag, GP_SECTION_MESH_TRI) == 0)
-            memset(st.copy[i], 0x7f, 4);
     gp_result summary;
     CHECK(decode(&st, &summary) == 0);
-    CHECK(gp_sections_read_mesh(&summary, read_stored, &st) == GP_EPARSE && summary.mesh.xy == NULL);
+    CHECK(run_mesh_writer(GP_FORMAT_MSH, &spec, &summary, &st, 0, 0) == 0);
+    CHECK(run_mesh_writer(GP_FORMAT_INP, &spec, &summary, &st, 0, 0) == 0);
+    CHECK(run_mesh_writer(GP_FORMAT_VTU, &spec, &summary, &st, 0, 0) == GP_EINVAL);
     gp_result_free(&summary);
+    /* the mesh summary of a result stored before the qualities (version 1) reads the same */
+    for (size_t i = 0; i < st.n; i++)
+        if (strcmp(st.sections[i].tag, GP_SECTION_MESH) == 0) {
+            CHECK(st.sections[i].version == GP_SECTION_MESH_VERSION);
+            memset(&summary, 0, sizeof summary);
+            CHECK(gp_section_decode_summary(GP_SECTION_MESH, 1, st.copy[i], st.sections[i].size, &summary) == 0);
+            CHECK(summary.has_mesh && summary.mesh.ntri == r.mesh.ntri && summary.mesh.nnodes == r.mesh.nnodes);
+            gp_result_free(&summary);
+            CHECK(gp_section_decode_summary(GP_SECTION_MESH, GP_SECTION_MESH_VERSION + 1, st.copy[i],
+                                            st.sections[i].size, &summary) == GP_EINVAL);
+            gp_result_free(&summary);
+        }
     unstore(&st);
     gp_result_free(&r);
     gp_spec_free(&spec);
@@ -376,6 +479,7 @@ int main(void)
     RUN(test_pack3d_sections);
     RUN(test_every_format_reads_the_same_from_sections);
     RUN(test_mesh_from_sections);
+    RUN(test_mesh_sections_refused);
     RUN(test_corrupt_sections_are_refused);
     RUN(test_pack_section_keeps_the_front_rule);
     return check_status();

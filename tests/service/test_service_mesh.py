@@ -10,14 +10,20 @@ job without one are 400; its vtu is the grains, which meshio reads). The downloa
 daemon's grainpack_pipeline_runs_total does not move. Responses are checked against
 openapi.yaml.
 A periodic spec with a mesh is accepted and its .msh carries the $Periodic section.
+The mesh formats are rendered from windows on the stored mesh: a walled mesh of triangles
+only and the periodic one download msh, inp and vtu (plain and gzip) byte for byte as the
+command line writes them, the .msh opened by Gmsh itself; a result stored before the
+elements' qualities were (the section deleted from the store) still downloads its vtu.
 Usage: test_service_mesh.py GRAINPACKD GRAINPACK"""
 
 import gzip
 import json
 import os
+import sqlite3
 import subprocess
 import tempfile
 
+import gmsh
 import meshio
 import numpy as np
 
@@ -46,6 +52,89 @@ def periodic_spec(**mesh):
     return spec
 
 
+def same_as_cli(c, client, cli, tmp, job, spec, label, formats=("msh", "inp", "vtu")):
+    """Each format's download, plain and gzip, is the command line's bytes for the spec;
+    returns the downloads."""
+    path = os.path.join(tmp, label + ".json")
+    with open(path, "w") as f:
+        json.dump(spec, f)
+    got = {}
+    for fmt in formats:
+        made = subprocess.run([cli, "run", path, "-f", fmt], capture_output=True, check=True).stdout
+        r = client.get(f"/jobs/{job}/results?f={fmt}")
+        c.check(r.status == 200 and r.body == made,
+                f"{label} {fmt}: the download ({r.status}, {len(r.body)} bytes) is not the command line's ({len(made)})")
+        z = client.get(f"/jobs/{job}/results?f={fmt}", headers={"Accept-Encoding": "gzip"})
+        c.check(z.status == 200 and z.headers.get("content-encoding") == "gzip" and gzip.decompress(z.body) == made,
+                f"{label} {fmt} gzip: {z.status}, {len(z.body)} bytes")
+        got[fmt] = r.body
+    return got
+
+
+def gmsh_reads(c, tmp, name, body, st):
+    """Gmsh itself opens a downloaded .msh: its nodes and elements are the statistics'."""
+    path = os.path.join(tmp, name)
+    with open(path, "wb") as f:
+        f.write(body)
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.open(path)
+        nodes, _, _ = gmsh.model.mesh.getNodes()
+        _, tags, _ = gmsh.model.mesh.getElements(2)
+        _, lines, _ = gmsh.model.mesh.getElements(1)
+        c.check(len(nodes) == st["nodes"] and sum(len(t) for t in tags) == st["elements"]["total"]
+                and sum(len(t) for t in lines) == st["boundary_edges"],
+                f"Gmsh reads {len(nodes)} nodes, {sum(len(t) for t in tags)} elements in {name}; "
+                f"the statistics say {st['nodes']}, {st['elements']['total']}")
+    finally:
+        gmsh.finalize()
+
+
+def check_walled_triangles(c, client, cli, tmp):
+    """A walled mesh of triangles only (no band layers), downloaded from its windows."""
+    spec = mesh_spec(element_size=3)
+    job = client.submit(spec).json()["jobID"]
+    info = client.wait_final(job)
+    if not c.check(info["status"] == "successful", f"the walled mesh job: {info}"):
+        return
+    st = client.get(f"/jobs/{job}/statistics").json()["mesh"]
+    c.check(st["elements"]["quadrilaterals"] == 0, f"quads without band_layers: {st['elements']}")
+    got = same_as_cli(c, client, cli, tmp, job, spec, "walled")
+    gmsh_reads(c, tmp, "walled.msh", got["msh"], st)
+    return job, spec
+
+
+def edit_store(c, daemon, sql, job):
+    """Runs one statement on the stopped daemon's store; its row count."""
+    c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
+    db = sqlite3.connect(daemon.db_path)
+    count = db.execute(sql, (job,)).rowcount
+    db.commit()
+    db.close()
+    daemon.start()
+    return count
+
+
+def check_stored_without_quality(c, daemon, cli, tmp, job, spec):
+    """The vtu download reads the elements' qualities stored with the mesh (section
+    mesh_quality, announced by the mesh section's version 2): without that section it is
+    cut short. A result stored before them (mesh version 1, no mesh_quality: what an older
+    grainpackd left) downloads its vtu from the mesh read whole, still the command line's
+    bytes; msh and inp read it window by window."""
+    gone = edit_store(c, daemon, "DELETE FROM result_sections WHERE job_id = ? AND tag = 'mesh_quality'", job)
+    c.check(gone == 1, f"the stored result had {gone} mesh_quality sections")
+    try:
+        r = daemon.client().get(f"/jobs/{job}/results?f=vtu")
+        whole = r.status == 200 and r.body.endswith(b"</VTKFile>\n")
+    except Exception:  # the connection closed before the end: what a cut-short download is
+        whole = False
+    c.check(not whole, "a vtu download without the stored qualities was not cut short: it did not read them")
+    older = edit_store(c, daemon, "UPDATE result_sections SET version = 1 WHERE job_id = ? AND tag = 'mesh'", job)
+    c.check(older == 1, f"the stored result had {older} mesh sections")
+    same_as_cli(c, daemon.client(), cli, tmp, job, spec, "old")
+
+
 def check_periodic(c, client, cli, tmp):
     """A periodic spec with a mesh is accepted; its .msh download, the command line's
     bytes, has the $Periodic section that meshio reads (test_mesh_readers has Gmsh's
@@ -70,6 +159,7 @@ def check_periodic(c, client, cli, tmp):
     c.check(len(links) == 2 and [len(lk[3]) for lk in links] == [st["periodic"]["node_pairs"]["x"],
                                                                  st["periodic"]["node_pairs"]["y"]],
             f"meshio reads {len(links)} periodic links")
+    same_as_cli(c, client, cli, tmp, info["jobID"], spec, "periodic", ("inp", "vtu"))
 
 
 def bad_specs():
@@ -230,6 +320,9 @@ def test(c, binary, cli):
             check_downloads(c, api, client, cli, tmp)
             check_without_mesh(c, api, client, tmp)
             check_periodic(c, client, cli, tmp)
+            walled = check_walled_triangles(c, client, cli, tmp)
+            if walled:
+                check_stored_without_quality(c, daemon, cli, tmp, *walled)
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
     finally:
         daemon.cleanup()

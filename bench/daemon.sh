@@ -1,0 +1,17 @@
+# daemon.sh - sourced by the download benchmarks: builds grainpackd in Release (unless
+# GP_DAEMON names one), starts it with one worker and the extra arguments given, in a
+# temporary data directory removed at exit. Sets GP_DAEMON, dir, pid, base (its URL),
+# load_start (the load average before), and rss KEY (a VmRSS/VmHWM of the daemon, in kB).
+if [ -z "${GP_DAEMON:-}" ]; then
+  cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release > /dev/null
+  cmake --build build-bench -j"$(nproc)" --target grainpackd > /dev/null
+  GP_DAEMON=./build-bench/server/grainpackd
+fi
+dir=$(mktemp -d)
+"$GP_DAEMON" --port 0 --data-dir "$dir" --ready-file "$dir/port" --workers 1 "$@" 2> "$dir/log" &
+pid=$!
+trap 'kill "$pid" 2> /dev/null; wait "$pid" 2> /dev/null; rm -rf "$dir"' EXIT
+while [ ! -s "$dir/port" ]; do sleep 0.05; done
+base="http://127.0.0.1:$(cat "$dir/port")"
+load_start=$(cut -d' ' -f1 /proc/loadavg)
+rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
