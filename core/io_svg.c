@@ -252,7 +252,8 @@ static void head(gp_writer *w, gp_out *out, int param)
     double L = W > H ? W : H;
     int dec = st->dec;
     double margin = 0.03 * L, font = 0.022 * L, bar_h = 0.025 * L;
-    double legend_h = bar_h + (3.5 + 1.4 * (w->result->has_balance + w->result->has_cells + w->result->has_mesh)) * font;
+    /* the mesh's caption takes two lines: on one, it ran past the right edge */
+    double legend_h = bar_h + (3.5 + 1.4 * (w->result->has_balance + w->result->has_cells + 2 * w->result->has_mesh)) * font;
     double vw = W + 2 * margin, vh = H + 2 * margin + legend_h;
     double px = PICTURE_PX / L;
     gp_out_puts(out, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -332,7 +333,7 @@ static void legend(gp_writer *w, gp_out *out, int param)
     attr(out, "<text x=\"", W / 2, dec);
     attr(out, " y=\"", text_y, dec);
     gp_out_printf(out, " text-anchor=\"middle\">%s%s</text>\n", c->title,
-                  c->by_F ? " (grey: not interior, F undefined)" : "");
+                  c->by_F ? " (grey: undefined)" : "");
     attr(out, "<text x=\"", W, dec);
     attr(out, " y=\"", text_y, dec);
     gp_out_printf(out, " text-anchor=\"end\">%s = %.4g</text>\n", c->symbol, c->hi);
@@ -360,9 +361,11 @@ static void legend(gp_writer *w, gp_out *out, int param)
     if (result->has_mesh) {
         const gp_mesh_stats *ms = &result->mesh.stats;
         attr(out, "<text x=\"0\" y=\"", line_y += 1.4 * font, dec);
-        gp_out_printf(out, ">mesh%s: %zu triangles, %zu quadrilaterals, %zu nodes, angles %.1f to %.1f degrees</text>\n",
+        gp_out_printf(out, ">mesh%s: %zu triangles, %zu quadrilaterals, %zu nodes</text>\n",
                       gp_svg_mesh_drawable(&result->mesh) ? "" : " (too fine to draw)",
-                      ms->triangles, ms->quads, ms->nodes, ms->min_angle, ms->max_angle);
+                      ms->triangles, ms->quads, ms->nodes);
+        attr(out, "<text x=\"0\" y=\"", line_y += 1.4 * font, dec);
+        gp_out_printf(out, ">element angles %.1f to %.1f degrees</text>\n", ms->min_angle, ms->max_angle);
     }
     GP_OUT_LITERAL(out, "</g>\n</svg>\n");
 }

@@ -844,6 +844,22 @@ struct Run {
         return added;
     }
 
+    // The two opposite sides given by corners c[0] -> c[1] and c[2] -> c[3] (a strip, or a
+    // periodic pair), as chains of nodes. With `what` (naming them in the message) their
+    // lengths must agree; NULL while nodes are still being mirrored from one to the other.
+    int side_pair(const int32_t *c, std::vector<Vertex_handle> &a, std::vector<Vertex_handle> &b,
+                  const char *what)
+    {
+        int rc;
+        if ((rc = side_chain(vertex[c[0]], vertex[c[1]], a)) ||
+            (rc = side_chain(vertex[c[2]], vertex[c[3]], b)))
+            return rc;
+        if (what && a.size() != b.size())
+            return gp_error_set(err, GP_EINTERNAL, NULL, "mesh: %s sides ended with %zu and %zu nodes",
+                                what, a.size(), b.size());
+        return 0;
+    }
+
     // Walks the sides of every strip (`pairs` false) or periodic pair (true) given by
     // their corners; mirrors the nodes one has onto the other, or (`lock`) protects them.
     // Clears *matched when some side needed a node.
@@ -851,10 +867,8 @@ struct Run {
     {
         std::vector<Vertex_handle> a, b;
         for (size_t s = 0; s < count; s++) {
-            const int32_t *c = corners + 4 * s;
-            int rc;
-            if ((rc = side_chain(vertex[c[0]], vertex[c[1]], a)) ||
-                (rc = side_chain(vertex[c[2]], vertex[c[3]], b)))
+            int rc = side_pair(corners + 4 * s, a, b, NULL);
+            if (rc)
                 return rc;
             if (lock) {
                 for (size_t k = 0; k + 1 < a.size(); k++)
@@ -878,14 +892,9 @@ struct Run {
     {
         std::vector<Vertex_handle> a, b;
         for (size_t s = 0; s < g.npairs; s++) {
-            const int32_t *c = g.pair_corners + 4 * s;
-            int rc;
-            if ((rc = side_chain(vertex[c[0]], vertex[c[1]], a)) ||
-                (rc = side_chain(vertex[c[2]], vertex[c[3]], b)))
+            int rc = side_pair(g.pair_corners + 4 * s, a, b, "periodic");
+            if (rc)
                 return rc;
-            if (a.size() != b.size())
-                return gp_error_set(err, GP_EINTERNAL, NULL,
-                                    "mesh: periodic sides ended with %zu and %zu nodes", a.size(), b.size());
             bool vertical = a.front()->point().x() == a.back()->point().x();
             for (size_t k = 1; k + 1 < a.size(); k++) {
                 double t = along(a[k], vertical), across = vertical ? b[k]->point().x() : b[k]->point().y();
@@ -1017,15 +1026,9 @@ struct Run {
         std::vector<Vertex_handle> a, b;
         out->strip_start[0] = 0;
         for (size_t s = 0; s < g.nstrips; s++) {
-            const int32_t *c = g.strip_corners + 4 * s;
-            int rc;
-            if ((rc = side_chain(vertex[c[0]], vertex[c[1]], a)) ||
-                (rc = side_chain(vertex[c[2]], vertex[c[3]], b)))
+            int rc = side_pair(g.strip_corners + 4 * s, a, b, "a strip's");
+            if (rc)
                 return rc;
-            if (a.size() != b.size())
-                return gp_error_set(err, GP_EINTERNAL, NULL,
-                                    "mesh: a strip's sides ended with %zu and %zu nodes", a.size(),
-                                    b.size());
             for (const Vertex_handle &v : a)
                 sides.push_back(v->node);
             for (const Vertex_handle &v : b)
