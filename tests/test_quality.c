@@ -75,6 +75,7 @@ static void test_cells_inside_as_by_division(void)
             CHECK_MSG(wrong == 0, "%s seed %llu: %zu centres answered otherwise", cases[c],
                       (unsigned long long)seed, wrong);
             gp_packing_free(&pk);
+            gp_spec_free(&spec);
         }
     CHECK_MSG(inside > 10000 && outside > 300, "inside %zu, outside %zu", inside, outside);
 }
