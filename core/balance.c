@@ -66,6 +66,8 @@ typedef struct balancer {
     double max_step;
     rings rings;        /* the rings of the structure the sweep starts from */
     nearby near;        /* the disks near the positions a centre tries */
+    int box_inside;     /* whether every position in near's box keeps the disk gathered for
+                           in the domain (walled domains; see gather) */
     settled settled;    /* the centres whose last step still holds (walled domains) */
     int remember;       /* whether `settled` is kept: walled domains only */
     double *F;          /* F of the structure the sweep starts from (NAN: not interior);
@@ -95,7 +97,16 @@ typedef struct balancer {
 static int gather(balancer *b, int32_t id, double x0, double y0, double x1, double y1)
 {
     double R = b->disks[id].R;
-    return nearby_gather(&b->near, b->disks, id, R, x0, y0, x1, y1, BOX_MARGIN_RTOL * R);
+    int rc = nearby_gather(&b->near, b->disks, id, R, x0, y0, x1, y1, BOX_MARGIN_RTOL * R);
+    /* the walls' test of gp_domain_contains_disk is monotone along each axis (x - R >=
+     * -slack grows with x, x + R <= W + slack holds for every x below one where it holds):
+     * when the box's two corners pass it, so does every position between them, and
+     * position_is_free need not ask again (a sixth of its time) */
+    const nearby *nb = &b->near;
+    b->box_inside = !b->domain->periodic &&
+                    gp_domain_contains_disk(b->domain, nb->x0, nb->y0, R, R * GP_CONTACT_RTOL) &&
+                    gp_domain_contains_disk(b->domain, nb->x1, nb->y1, R, R * GP_CONTACT_RTOL);
+    return rc;
 }
 
 /* Whether every disk that could overlap a disk of radius R at (x, y) has its images in
@@ -116,6 +127,8 @@ static int within_layer(const balancer *b, double x, double y, double R)
 static int position_is_free(balancer *b, int32_t id, double x, double y)
 {
     double R = b->disks[id].R;
+    if (b->box_inside && nearby_in_box(&b->near, x, y, R))
+        return nearby_is_clear_in_box(&b->near, x, y);
     return gp_domain_contains_disk(b->domain, x, y, R, R * GP_CONTACT_RTOL) &&
            (!b->domain->periodic || within_layer(b, x, y, R)) &&
            nearby_is_clear(&b->near, b->disks, id, R, x, y);
@@ -149,7 +162,7 @@ static int target_of(balancer *b, int32_t id, const int32_t *ring, size_t degree
     double *t = b->tangent;
     for (size_t k = 0; k < degree; k++) {
         /* the link edge (q1, q2) has p on its left: the tangent position on p's side */
-        const gp_disk *q1 = &b->disks[ring[k]], *q2 = &b->disks[ring[(k + 1) % degree]];
+        const gp_disk *q1 = &b->disks[ring[k]], *q2 = &b->disks[ring[k + 1 < degree ? k + 1 : 0]];
         if (!gp_place_tangent(q1, q2, p->R, &t[2 * k], &t[2 * k + 1])) {
             t[2 * k] = NAN;
             continue;
@@ -281,9 +294,9 @@ static void prefetch_visit(const balancer *b, size_t i)
         const int32_t *ring = rings_of(&b->rings, (int32_t)j, &degree);
         for (size_t k = 0; k < degree; k++)
             __builtin_prefetch(&b->disks[ring[k]]);
-        nearby_prefetch_cells(&b->near, b->disks[j].x, b->disks[j].y);
+        size_t cell = nearby_prefetch_cells(&b->near, b->disks[j].x, b->disks[j].y);
         if (b->remember)
-            settled_prefetch(&b->settled, b->disks[j].x, b->disks[j].y);
+            settled_prefetch(&b->settled, cell);
     }
     if (i + AHEAD_ENTRIES < b->n)
         nearby_prefetch_entries(&b->near, b->disks[i + AHEAD_ENTRIES].x, b->disks[i + AHEAD_ENTRIES].y);

@@ -12,7 +12,14 @@
 /* A grid of about one cell per disk or fewer, as the packer's. */
 #define CELLS_PER_DISK 8
 
-static int reserve(nearby *nb, size_t need);
+static int grow_gathered(nearby *nb, size_t need);
+
+/* Room for `need` gathered disks; 0 or GP_ENOMEM. Inline: a gathering asks once a row
+ * and once a moved disk, and the room is nearly always there. */
+static inline int reserve(nearby *nb, size_t need)
+{
+    return need <= nb->gcap ? 0 : grow_gathered(nb, need);
+}
 
 int nearby_init(nearby *nb, const gp_domain *domain, const gp_disk *disks, size_t n, double R_max)
 {
@@ -58,7 +65,7 @@ void nearby_sort(nearby *nb, const gp_disk *disks)
     nb->start[0] = 0;
 }
 
-void nearby_prefetch_cells(const nearby *nb, double x, double y)
+size_t nearby_prefetch_cells(const nearby *nb, double x, double y)
 {
     const gp_grid *g = &nb->grid;
     size_t c = gp_grid_cell(g, x, y);
@@ -69,6 +76,7 @@ void nearby_prefetch_cells(const nearby *nb, double x, double y)
         __builtin_prefetch(&g->head[first]);
         __builtin_prefetch(&g->head[first + 3]);
     }
+    return c;
 }
 
 void nearby_prefetch_entries(const nearby *nb, double x, double y)
@@ -94,11 +102,9 @@ void nearby_move(nearby *nb, const gp_disk *disks, int32_t id, double old_x, dou
     gp_grid_insert(&nb->grid, id, disks[id].x, disks[id].y);
 }
 
-/* Room for `need` gathered disks; 0 or GP_ENOMEM. */
-static int reserve(nearby *nb, size_t need)
+/* reserve when the room is not there. */
+static int grow_gathered(nearby *nb, size_t need)
 {
-    if (need <= nb->gcap)
-        return 0;
     size_t cap = grow_capacity(nb->gcap, need);
     double *gx = cap ? grow_realloc(nb->gx, cap, sizeof *gx) : NULL;
     if (gx)
@@ -124,12 +130,13 @@ static double overlap_reach2(double Rq, double R)
 
 /* Appends a disk of radius Rq to the gathered ones when `keep` (room reserved): written
  * either way, counted only if kept, so that the loops around it have no branch to
- * mispredict. */
+ * mispredict. Its radius waits in gr2 for nearby_gather to turn it into the reach, once
+ * the disks read but not kept are out of the way. */
 static void keep_if(nearby *nb, double x, double y, double Rq, int keep)
 {
     nb->gx[nb->gn] = x;
     nb->gy[nb->gn] = y;
-    nb->gr2[nb->gn] = overlap_reach2(Rq, nb->gR);
+    nb->gr2[nb->gn] = Rq;
     nb->gn += (size_t)keep;
 }
 
@@ -170,6 +177,8 @@ int nearby_gather(nearby *nb, const gp_disk *disks, int32_t id, double R, double
                 keep_if(nb, disks[j].x, disks[j].y, disks[j].R, near_box(nb, disks[j].x, disks[j].y, disks[j].R, R) & (j != id));
             }
     }
+    for (size_t k = 0; k < nb->gn; k++)
+        nb->gr2[k] = overlap_reach2(nb->gr2[k], R);
     return 0;
 }
 
@@ -179,36 +188,50 @@ static int overlaps(double dx, double dy, double Rq, double R)
     return !(dx * dx + dy * dy >= overlap_reach2(Rq, R));
 }
 
+/* nearby_is_clear_in_box's loop over the gathered disks runs two at a time in the x86-64
+ * baseline's SSE2, four at a time with AVX2: built both ways where GCC can, the loader
+ * picks the one the processor runs. The same operations on each disk either way (AVX2
+ * alone brings no fused multiply-add), so the same answers. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CLEAR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CLEAR_CLONES
+#endif
+
+CLEAR_CLONES int nearby_is_clear_in_box(nearby *nb, double x, double y)
+{
+    const double *gx = nb->gx, *gy = nb->gy, *gr2 = nb->gr2;
+    size_t n = nb->gn;
+    /* the disk that blocked the last position blocks most of the next ones (a
+     * blocked centre tries twenty positions on one line) */
+    if (nb->blocker < n) {
+        size_t k = nb->blocker;
+        double dx = gx[k] - x, dy = gy[k] - y;
+        if (dx * dx + dy * dy < gr2[k])
+            return 0;
+    }
+    /* every disk, without a branch: the loop runs two disks at a time */
+    long hits = 0;
+    for (size_t k = 0; k < n; k++) {
+        double dx = gx[k] - x, dy = gy[k] - y;
+        hits += dx * dx + dy * dy < gr2[k];
+    }
+    if (hits == 0)
+        return 1;
+    for (size_t k = 0; k < n; k++) {
+        double dx = gx[k] - x, dy = gy[k] - y;
+        if (dx * dx + dy * dy < gr2[k]) {
+            nb->blocker = k;
+            break;
+        }
+    }
+    return 0;
+}
+
 int nearby_is_clear(nearby *nb, const gp_disk *disks, int32_t id, double R, double x, double y)
 {
-    if (x >= nb->x0 && x <= nb->x1 && y >= nb->y0 && y <= nb->y1 && R == nb->gR) {
-        const double *gx = nb->gx, *gy = nb->gy, *gr2 = nb->gr2;
-        size_t n = nb->gn;
-        /* the disk that blocked the last position blocks most of the next ones (a
-         * blocked centre tries twenty positions on one line) */
-        if (nb->blocker < n) {
-            size_t k = nb->blocker;
-            double dx = gx[k] - x, dy = gy[k] - y;
-            if (dx * dx + dy * dy < gr2[k])
-                return 0;
-        }
-        /* every disk, without a branch: the loop runs two disks at a time */
-        long hits = 0;
-        for (size_t k = 0; k < n; k++) {
-            double dx = gx[k] - x, dy = gy[k] - y;
-            hits += dx * dx + dy * dy < gr2[k];
-        }
-        if (hits == 0)
-            return 1;
-        for (size_t k = 0; k < n; k++) {
-            double dx = gx[k] - x, dy = gy[k] - y;
-            if (dx * dx + dy * dy < gr2[k]) {
-                nb->blocker = k;
-                break;
-            }
-        }
-        return 0;
-    }
+    if (nearby_in_box(nb, x, y, R))
+        return nearby_is_clear_in_box(nb, x, y);
     /* outside the box: the cells within R + R_max of (x, y) */
     const gp_grid *g = &nb->grid;
     double reach = R + nb->R_max;

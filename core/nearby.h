@@ -57,7 +57,7 @@ void nearby_sort(nearby *nb, const gp_disk *disks);
  * them. Only a hint: the answers do not change. (The sweeps visit the centres in id
  * order, which on the packer's ids jumps across the structure: at 10^6 grains the median
  * distance between consecutive ids is 500 radii, and every gathering waited on memory.) */
-void nearby_prefetch_cells(const nearby *nb, double x, double y);
+size_t nearby_prefetch_cells(const nearby *nb, double x, double y); /* returns the cell of (x, y) */
 void nearby_prefetch_entries(const nearby *nb, double x, double y);
 
 /* Disk `id`, which was at (old_x, old_y), is now at disks[id]. */
@@ -74,6 +74,17 @@ int nearby_gather(nearby *nb, const gp_disk *disks, int32_t id, double R, double
  * lies in their box and R is the radius they were gathered for, else against the cells
  * around it. Remembers which gathered disk blocked it, to test that one first next time. */
 int nearby_is_clear(nearby *nb, const gp_disk *disks, int32_t id, double R, double x, double y);
+
+/* Whether a disk of radius R at (x, y) is one the gathered disks answer for: (x, y) in
+ * their box and R the radius they were gathered for. */
+static inline int nearby_in_box(const nearby *nb, double x, double y, double R)
+{
+    return x >= nb->x0 && x <= nb->x1 && y >= nb->y0 && y <= nb->y1 && R == nb->gR;
+}
+
+/* nearby_is_clear for a position nearby_in_box accepts: tested against the gathered disks
+ * alone. */
+int nearby_is_clear_in_box(nearby *nb, double x, double y);
 
 void nearby_free(nearby *nb);
 

@@ -2,6 +2,7 @@
  * a centre and its triangulation neighbours, over its packing radius. */
 #include "quality.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,24 +27,51 @@ static int axis_inside(int periodic, double o, double L, double box, double reac
  * it, and F would measure that instead. Along a periodic axis, the vertex's power circle
  * grown by R_max must lie in the box of the ghosts: a site left out cuts the cell only
  * if it is nearer in power than p to one of its vertices (laguerre.c, cell_complete). */
+/* c = (|q - p|^2 + R_p^2 - R_q^2) / 2 for q - p = (qx, qy): the power vertices u
+ * relative to p of the triangles around p with q solve u.(q - p) = c (equal power
+ * distance to p and q). */
+static double power_offset(const gp_disk *p, double qx, double qy, double qR)
+{
+    return 0.5 * (qx * qx + qy * qy + p->R * p->R - qR * qR);
+}
+
 int quality_cell_inside(const quality_frame *frame, const gp_disk *disks, int32_t i,
                         const int32_t *ring, size_t degree)
 {
     const gp_domain *domain = frame->domain;
     const gp_disk *p = &disks[i];
+    /* walled domains: half the distance from p to the nearer wall along each axis. A
+     * vertex whose offset from p is within it is inside without the two divisions: from
+     * |n| <= det * m, |n / det| rounded and added to p's coordinate stay far from the
+     * walls (a few ulps against half the distance), so the test below gives the answer
+     * the divisions would; a vertex nearer the walls is divided for. */
+    double wx = domain->width - p->x, wy = domain->height - p->y;
+    double mx = 0.5 * (p->x < wx ? p->x : wx), my = 0.5 * (p->y < wy ? p->y : wy);
     int answer = 1;
+    /* each ring entry's offset is read twice, as the end of one edge and the start of
+     * the next: computed once, the same value either way */
+    const gp_disk *a = &disks[ring[0]];
+    double ax = a->x - p->x, ay = a->y - p->y, ca = power_offset(p, ax, ay, a->R);
     for (size_t k = 0; k < degree; k++) {
-        const gp_disk *a = &disks[ring[k]], *b = &disks[ring[(k + 1) % degree]];
-        /* the power vertex o = p + u solves u.(a - p) = ca and u.(b - p) = cb, where
-         * c = (|q - p|^2 + R_p^2 - R_q^2) / 2 (equal power distance to p and q) */
-        double ax = a->x - p->x, ay = a->y - p->y, bx = b->x - p->x, by = b->y - p->y;
-        double ca = 0.5 * (ax * ax + ay * ay + p->R * p->R - a->R * a->R);
-        double cb = 0.5 * (bx * bx + by * by + p->R * p->R - b->R * b->R);
+        /* the next ring entry without `%`: an integer division, slow, on every edge */
+        const gp_disk *b = &disks[ring[k + 1 < degree ? k + 1 : 0]];
+        /* the power vertex o = p + u solves u.(a - p) = ca and u.(b - p) = cb */
+        double bx = b->x - p->x, by = b->y - p->y, cb = power_offset(p, bx, by, b->R);
         double det = ax * by - ay * bx;
         if (!(det > 0.0))
             return 0;
-        double ux = (ca * by - cb * ay) / det, uy = (ax * cb - bx * ca) / det;
+        double nx = ca * by - cb * ay, ny = ax * cb - bx * ca;
+        if (!domain->periodic && det < DBL_MAX && fabs(nx) <= det * mx && fabs(ny) <= det * my) {
+            ax = bx;
+            ay = by;
+            ca = cb;
+            continue;
+        }
+        double ux = nx / det, uy = ny / det;
         double ox = p->x + ux, oy = p->y + uy;
+        ax = bx;
+        ay = by;
+        ca = cb;
         if (!domain->periodic) {
             if (!(ox >= 0.0 && oy >= 0.0 && ox <= domain->width && oy <= domain->height))
                 return 0;

@@ -60,9 +60,8 @@ int settled_moved(settled *s, int32_t id, double old_x, double old_y, double x, 
     return log_position(s, id, old_x, old_y) || log_position(s, id, x, y) ? GP_ENOMEM : 0;
 }
 
-void settled_prefetch(const settled *s, double x, double y)
+void settled_prefetch(const settled *s, size_t c)
 {
-    size_t c = gp_grid_cell(s->grid, x, y);
     for (int k = 0; k < 2; k++)
         for (int row = -1; row <= 1; row++)
             __builtin_prefetch(&s->log[k].head[c + (size_t)((ptrdiff_t)row * s->grid->stride) - 1]);

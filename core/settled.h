@@ -70,9 +70,9 @@ void settled_record(settled *s, int32_t id, int state, double x0, double y0, dou
  * the test that picks the gathered disks); else SETTLED_UNKNOWN, and its state is forgotten. */
 int settled_holds(settled *s, const gp_disk *disks, int32_t id, double R);
 
-/* Asks the memory for the cells' chains settled_holds will read for a centre at (x, y):
- * only a hint (see nearby_prefetch_cells). */
-void settled_prefetch(const settled *s, double x, double y);
+/* Asks the memory for the cells' chains settled_holds will read for a centre in cell c
+ * of the grid (the one nearby_prefetch_cells returns): only a hint. */
+void settled_prefetch(const settled *s, size_t c);
 
 void settled_free(settled *s);
 
