@@ -76,9 +76,30 @@ with tempfile.TemporaryDirectory() as tmp:
     refused({"domain": box, "distribution": {"kind": "uniform", "min": 0.01, "max": 0.3}}, 3,
             "/distribution/min")
     refused({"domain": dict(box, periodic=["x"]), "distribution": law}, 3, "/domain/periodic")
-    rc, _, err = run(["run", "-"], stdin=json.dumps({"domain": box, "distribution": law, "balance": {"method": "relocation"}}).encode())
-    check(rc == 1 and "/balance" not in err and "balancing is not available" in err,
-          "3D balance before gp_balance3d: %d %s" % (rc, err))
+    # balanced by relocation: F_max does not rise, the spheres stay apart and in the box
+    # (the JSON's own positions, checked here), F is given where a centre is interior
+    balanced = json.loads(json.dumps(SPEC))
+    balanced["inputs"]["balance"] = {"method": "relocation"}
+    rc, got, err = run(["run", "-", "-f", "json"], stdin=json.dumps(balanced).encode())
+    check(rc == 0, "balanced run exited %d: %s" % (rc, err))
+    doc = json.loads(got) if rc == 0 else {"balance": {"before": {}, "after": {}}, "spheres": []}
+    b = doc["balance"]
+    check(b.get("method") == "relocation" and b.get("sweeps", 0) >= 1 and
+          b["after"].get("max", 9) <= b["before"].get("max", 0) and b["after"].get("interior", 0) > 10,
+          "balance %r" % {k: b.get(k) for k in ("method", "sweeps", "before", "after")})
+    bs = [(q["x"], q["y"], q["z"], q["R"]) for q in doc["spheres"]]
+    check(len(bs) == len(s) and sum(q["F"] is not None for q in doc["spheres"]) == b["after"].get("interior"),
+          "balanced spheres %d, with F %d" % (len(bs), sum(q["F"] is not None for q in doc["spheres"])))
+    moved = sum(a[:3] != tuple(t[:3]) for a, t in zip(bs, s))
+    check(moved > 0, "balancing moved no sphere")
+    worst = -1.0
+    for i in range(len(bs)):
+        x, y, z, R = bs[i]
+        for c, side in ((x, W), (y, H), (z, D)):
+            check(c - R >= -1e-9 * R and c + R <= side + 1e-9 * R, "balanced outside: %r" % (bs[i],))
+        for j in range(i):
+            worst = max(worst, 1.0 - math.dist(bs[i][:3], bs[j][:3]) / (R + bs[j][3]))
+    check(worst <= 1e-9, "balanced: worst overlap %g" % worst)
     refused({"inputs": {"domain": dict(box, depth="deep"), "distribution": law}}, 3,
             "/inputs/domain/depth")
     refused({"domain": box, "distribution": law}, 2, "unknown format 'vtk' for pack3d", ["-f", "vtk"])
