@@ -58,7 +58,7 @@ def bad_specs():
         ("a negative depth", "pack3d", negative, "/inputs/domain/depth"),
         ("a box without depth", "pack3d", flat, "/inputs/domain/depth"),
         # the command line runs these; the service stores and serves the spheres only
-        ("a balancing asked of the service's pack3d", "pack3d", spec3d(balance={}), "/inputs/balance"),
+        ("a balancing asked of the service's pack3d", "pack3d", spec3d(balance={"method": "relocation"}), "/inputs/balance"),
         ("polyhedra asked of the service's pack3d", "pack3d", spec3d(laguerre={"shrink": "offset"}),
          "/inputs/laguerre"),
         ("a sphere larger than the box", "pack3d", big, "/inputs/domain/depth"),
