@@ -407,7 +407,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "grainpack: unknown format '%s' for pack3d (expected json, csv, vtu, tess or "
                         "svg)\n", format_name);
         status = EXIT_USAGE;
-    } else if (!is3d && gp_format_parse(format_name, &format)) {
+    } else if (!is3d && (gp_format_parse(format_name, &format) || format == GP_FORMAT_TESS)) {
         fprintf(stderr, "grainpack: unknown format '%s' (expected json, csv, svg, vtk, vtu, msh "
                         "or inp)\n", format_name);
         status = EXIT_USAGE;

@@ -17,6 +17,9 @@ static const struct {
     [GP_FORMAT_MSH] = {"msh", "text/x-gmsh; charset=utf-8", 1},
     [GP_FORMAT_INP] = {"inp", "text/x-abaqus-input; charset=utf-8", 1},
     [GP_FORMAT_VTU] = {"vtu", "application/x-vtu+xml", 1},
+    /* Neper's tessellation has none either; not text/plain, which would win a 2D job's
+       "Accept: text/plain" for a format it does not have */
+    [GP_FORMAT_TESS] = {"tess", "text/x-neper-tess; charset=utf-8", 1},
 };
 
 int gp_format_needs_mesh(gp_format format)

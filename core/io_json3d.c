@@ -55,7 +55,7 @@ static json_t *statistics_json(const gp_spec3d *spec, const gp_result3d *result,
     return o;
 }
 
-static json_t *cells_json(const gp_cells3d *cells, const gp_cell3d_stats *c, int *failed)
+json_t *gp_json_cells3d(const gp_cells3d *cells, const gp_cell3d_stats *c, int *failed)
 {
     json_t *o = json_object();
     put(o, "count", json_integer((json_int_t)c->count), failed);
@@ -152,7 +152,7 @@ int gp_write_json3d(gp_out *out, const gp_spec3d *spec, const gp_result3d *resul
     if (result->has_balance)
         put(head, "balance", gp_json_balance(&result->balance, &failed), &failed);
     if (result->has_cells)
-        put(head, "cells", cells_json(&result->cells, &result->cell_stats, &failed), &failed);
+        put(head, "cells", gp_json_cells3d(&result->cells, &result->cell_stats, &failed), &failed);
     if (failed) {
         json_decref(head);
         return GP_ENOMEM;

@@ -8,6 +8,7 @@
 
 #include <jansson.h>
 
+#include "grainpack/geometry3d.h"
 #include "grainpack/out.h"
 #include "grainpack/pipeline.h"
 #include "grainpack/spec.h"
@@ -46,5 +47,9 @@ json_t *gp_json_counts(const size_t *counts, size_t n, int *failed);
 json_t *gp_json_balance(const gp_balance_result *b, int *failed);
 json_t *gp_json_distribution(const gp_distribution *d, int *failed);
 json_t *gp_json_joint(const gp_joint *j, int *failed);
+/* The polyhedra's statistics as the 3D JSON writes them under "cells" (count, shrink,
+ * faces, vertices, volume, faces_per_cell, ...): reads cells->shrink and `stats` only, so
+ * a summary decoded from the store serves as well. */
+json_t *gp_json_cells3d(const gp_cells3d *cells, const gp_cell3d_stats *stats, int *failed);
 
 #endif

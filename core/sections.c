@@ -137,6 +137,20 @@ static void encode_balance(enc *e, const gp_balance_result *b)
     put_u32(e, (uint32_t)b->after_only);
 }
 
+/* The equivalent radii of cells (2D or 3D): min, max, mean, mean ratio, bins, outside,
+ * max |z|. */
+static void put_req(enc *e, double min, double max, double mean, double ratio_mean,
+                    const gp_bin_stat *bins, size_t nbins, size_t outside, double max_abs_z)
+{
+    put_f64(e, min);
+    put_f64(e, max);
+    put_f64(e, mean);
+    put_f64(e, ratio_mean);
+    put_bins(e, bins, nbins);
+    put_u64(e, outside);
+    put_f64(e, max_abs_z);
+}
+
 static void encode_cells(enc *e, const gp_cells *c, const gp_cell_stats *s)
 {
     put_u64(e, c->count);
@@ -154,13 +168,8 @@ static void encode_cells(enc *e, const gp_cells *c, const gp_cell_stats *s)
     put_counts(e, s->neighbour_histogram, s->max_neighbours + 1);
     put_f64(e, s->band_fraction);
     put_f64(e, s->tiling_error);
-    put_f64(e, s->req_min);
-    put_f64(e, s->req_max);
-    put_f64(e, s->req_mean);
-    put_f64(e, s->req_ratio_mean);
-    put_bins(e, s->req_bins, s->nbins);
-    put_u64(e, s->req_outside);
-    put_f64(e, s->req_max_abs_z);
+    put_req(e, s->req_min, s->req_max, s->req_mean, s->req_ratio_mean, s->req_bins, s->nbins,
+            s->req_outside, s->req_max_abs_z);
 }
 
 /* Per cell, its vertex and neighbour counts (u32 each). */
@@ -455,6 +464,41 @@ static int decode_balance(dec *d, gp_result *r)
     return 0;
 }
 
+/* A histogram of max + 1 counts after its max (a corrupt max must not make a huge
+ * allocation: it fails the decoder instead). Returns 0 or GP_ENOMEM. */
+static int get_histogram(dec *d, size_t *max, size_t **out)
+{
+    *max = get_size(d);
+    if (d->failed || *max >= d->left / sizeof(uint64_t)) {
+        d->failed = 1;
+        return 0;
+    }
+    if (!(*out = calloc(*max + 1, sizeof **out)))
+        return GP_ENOMEM;
+    get_counts(d, *out, *max + 1);
+    return 0;
+}
+
+/* The equivalent radii of cells (2D or 3D), as put_req wrote them. */
+typedef struct req_fields {
+    double *min, *max, *mean, *ratio_mean;
+    gp_bin_stat **bins;
+    size_t *nbins, *outside;
+    double *max_abs_z;
+} req_fields;
+
+static int get_req(dec *d, req_fields f)
+{
+    *f.min = get_f64(d);
+    *f.max = get_f64(d);
+    *f.mean = get_f64(d);
+    *f.ratio_mean = get_f64(d);
+    int rc = get_bins(d, f.bins, f.nbins);
+    *f.outside = get_size(d);
+    *f.max_abs_z = get_f64(d);
+    return rc;
+}
+
 static int decode_cells(dec *d, gp_result *r)
 {
     gp_cells *c = &r->cells;
@@ -471,24 +515,13 @@ static int decode_cells(dec *d, gp_result *r)
     s->area_mean = get_f64(d);
     get_counts(d, s->area_histogram, GP_CELL_AREA_BINS);
     s->neighbours_mean = get_f64(d);
-    s->max_neighbours = get_size(d);
-    if (d->failed || s->max_neighbours >= d->left / sizeof(uint64_t)) {
-        d->failed = 1;
-        return 0;
-    }
-    s->neighbour_histogram = calloc(s->max_neighbours + 1, sizeof *s->neighbour_histogram);
-    if (!s->neighbour_histogram)
-        return GP_ENOMEM;
-    get_counts(d, s->neighbour_histogram, s->max_neighbours + 1);
+    int rc = get_histogram(d, &s->max_neighbours, &s->neighbour_histogram);
+    if (rc || d->failed)
+        return rc;
     s->band_fraction = get_f64(d);
     s->tiling_error = get_f64(d);
-    s->req_min = get_f64(d);
-    s->req_max = get_f64(d);
-    s->req_mean = get_f64(d);
-    s->req_ratio_mean = get_f64(d);
-    int rc = get_bins(d, &s->req_bins, &s->nbins);
-    s->req_outside = get_size(d);
-    s->req_max_abs_z = get_f64(d);
+    rc = get_req(d, (req_fields){&s->req_min, &s->req_max, &s->req_mean, &s->req_ratio_mean,
+                                 &s->req_bins, &s->nbins, &s->req_outside, &s->req_max_abs_z});
     r->has_cells = !d->failed && rc == 0;
     return rc;
 }
@@ -897,6 +930,268 @@ void gp_summary3d_free(gp_summary3d *summary)
 {
     gp_pack3d_stats_free(&summary->stats);
     memset(summary, 0, sizeof *summary);
+}
+
+/* --- the 3D stages after packing --- */
+
+/* The polyhedra's summary: count, shrink, their statistics (with the totals of vertices
+ * and faces), the .tess text's length. */
+static void encode_cells3d(enc *e, const gp_cells3d *c, const gp_cell3d_stats *s, size_t tess_len)
+{
+    put_u64(e, c->count);
+    put_u32(e, (uint32_t)c->shrink);
+    put_f64(e, c->power_volume_sum);
+    put_u64(e, s->count);
+    put_u64(e, s->faces);
+    put_u64(e, s->vertices);
+    put_f64(e, s->volume_min);
+    put_f64(e, s->volume_max);
+    put_f64(e, s->volume_mean);
+    put_counts(e, s->volume_histogram, GP_CELL_VOLUME_BINS);
+    put_f64(e, s->faces_mean);
+    put_u64(e, s->max_faces);
+    put_counts(e, s->faces_histogram, s->max_faces + 1);
+    put_f64(e, s->neighbours_mean);
+    put_f64(e, s->boundary_fraction);
+    put_f64(e, s->tiling_error);
+    put_req(e, s->req_min, s->req_max, s->req_mean, s->req_ratio_mean, s->req_bins, s->nbins,
+            s->req_outside, s->req_max_abs_z);
+    put_u64(e, tess_len);
+}
+
+/* Per cell its vertex and face counts, into `sizes`; per face its vertex count, into
+ * `face_sizes`. Returns 0 or GP_ETOOBIG. */
+static int encode_cell3d_sizes(enc *sizes, enc *face_sizes, const gp_cells3d *c)
+{
+    for (size_t i = 0; i < c->count; i++) {
+        size_t v = c->vstart[i + 1] - c->vstart[i], f = c->fstart[i + 1] - c->fstart[i];
+        if (v > UINT32_MAX || f > UINT32_MAX)
+            return GP_ETOOBIG;
+        put_u32(sizes, (uint32_t)v);
+        put_u32(sizes, (uint32_t)f);
+    }
+    for (size_t f = 0; f < c->fstart[c->count]; f++) {
+        size_t k = c->fvstart[f + 1] - c->fvstart[f];
+        if (k > UINT32_MAX)
+            return GP_ETOOBIG;
+        put_u32(face_sizes, (uint32_t)k);
+    }
+    return 0;
+}
+
+int gp_sections_from_result3d(const gp_box *box, const gp_result3d *r, const char *tess,
+                              size_t tess_len, gp_section *s, size_t *n)
+{
+    int rc = gp_sections_from_packing3d(box, &r->packing, &r->stats, s, n);
+    if (rc)
+        return rc;
+    enc e = {0}, f = {0};
+    if (r->has_balance) {
+        encode_balance(&e, &r->balance);
+        if (e.failed)
+            goto fail;
+        add(s, n, GP_SECTION_BALANCE3D, 1, NULL, 0, &e);
+        add(s, n, GP_SECTION_F, 0, r->balance.F, r->packing.count * sizeof(double), NULL);
+    }
+    if (r->has_cells) {
+        const gp_cells3d *c = &r->cells;
+        size_t faces = c->fstart[c->count];
+        e = (enc){0};
+        encode_cells3d(&e, c, &r->cell_stats, tess ? tess_len : 0);
+        if (e.failed)
+            goto fail;
+        add(s, n, GP_SECTION_CELLS3D, 1, NULL, 0, &e);
+        e = (enc){0};
+        rc = encode_cell3d_sizes(&e, &f, c);
+        if (rc || e.failed || f.failed)
+            goto fail;
+        add(s, n, GP_SECTION_CELL3D_SIZES, 0, NULL, 0, &e);
+        add(s, n, GP_SECTION_CELL3D_FACE_SIZES, 0, NULL, 0, &f);
+        e = f = (enc){0};
+        add(s, n, GP_SECTION_CELL3D_FACE_NEIGHBOURS, 0, c->fneighbour, faces * sizeof(int32_t), NULL);
+        add(s, n, GP_SECTION_CELL3D_FACE_VERTICES, 0, c->fverts, c->fvstart[faces] * sizeof(uint32_t),
+            NULL);
+        add(s, n, GP_SECTION_CELL3D_XYZ, 0, c->xyz, 3 * c->vstart[c->count] * sizeof(double), NULL);
+        add(s, n, GP_SECTION_CELL3D_VOLUME, 0, c->volume, c->count * sizeof(double), NULL);
+    }
+    if (tess)
+        add(s, n, GP_SECTION_TESS, 0, tess, tess_len, NULL);
+    return 0;
+fail:
+    free(e.buf);
+    free(f.buf);
+    gp_sections_free(s, *n);
+    *n = 0;
+    return rc ? rc : GP_ENOMEM;
+}
+
+static int decode_cells3d(dec *d, gp_result3d *r, size_t *tess_len)
+{
+    gp_cells3d *c = &r->cells;
+    gp_cell3d_stats *s = &r->cell_stats;
+    c->count = get_size(d);
+    c->shrink = (gp_shrink)get_u32(d);
+    c->power_volume_sum = get_f64(d);
+    if (c->shrink != GP_SHRINK_NONE && c->shrink != GP_SHRINK_OFFSET &&
+        c->shrink != GP_SHRINK_HOMOTHETIC)
+        d->failed = 1;
+    s->count = get_size(d);
+    s->faces = get_size(d);
+    s->vertices = get_size(d);
+    s->volume_min = get_f64(d);
+    s->volume_max = get_f64(d);
+    s->volume_mean = get_f64(d);
+    get_counts(d, s->volume_histogram, GP_CELL_VOLUME_BINS);
+    s->faces_mean = get_f64(d);
+    int rc = get_histogram(d, &s->max_faces, &s->faces_histogram);
+    if (rc || d->failed)
+        return rc;
+    s->neighbours_mean = get_f64(d);
+    s->boundary_fraction = get_f64(d);
+    s->tiling_error = get_f64(d);
+    rc = get_req(d, (req_fields){&s->req_min, &s->req_max, &s->req_mean, &s->req_ratio_mean,
+                                 &s->req_bins, &s->nbins, &s->req_outside, &s->req_max_abs_z});
+    *tess_len = get_size(d);
+    return rc;
+}
+
+int gp_section_decode_result3d(const gp_section *raw, size_t nraw, gp_box *box, gp_result3d *out,
+                               size_t *tess_len)
+{
+    memset(out, 0, sizeof *out);
+    memset(box, 0, sizeof *box);
+    *tess_len = 0;
+    int rc = GP_EINVAL;
+    for (size_t i = 0; i < nraw; i++)
+        if (strcmp(raw[i].tag, GP_SECTION_PACK3D) == 0) {
+            gp_summary3d sum;
+            rc = gp_section_decode_summary3d(raw[i].tag, raw[i].version, raw[i].data, raw[i].size,
+                                             &sum);
+            if (rc)
+                return rc;
+            *box = sum.box;
+            out->packing = sum.packing;
+            out->stats = sum.stats; /* its bins taken over */
+        }
+    for (size_t i = 0; i < nraw && rc == 0; i++) {
+        int balance = strcmp(raw[i].tag, GP_SECTION_BALANCE3D) == 0;
+        int cells = strcmp(raw[i].tag, GP_SECTION_CELLS3D) == 0;
+        if (!balance && !cells)
+            continue;
+        if (raw[i].version != LAYOUT_V1) {
+            rc = GP_EINVAL;
+            break;
+        }
+        dec d = {raw[i].data, raw[i].size, 0};
+        if (balance) {
+            out->has_balance = 1;
+            gp_result tmp = {0};
+            rc = decode_balance(&d, &tmp);
+            out->balance = tmp.balance;
+        } else {
+            out->has_cells = 1;
+            rc = decode_cells3d(&d, out, tess_len);
+            if (out->cell_stats.count != out->cells.count)
+                d.failed = 1;
+        }
+        if (rc == 0 && (d.failed || d.left != 0))
+            rc = GP_EPARSE;
+    }
+    if (rc)
+        gp_result3d_free(out);
+    return rc;
+}
+
+/* Reads `count` records of `size` bytes of section `tag` whole into a new buffer. */
+static int read_whole(gp_section_read_fn read, void *ctx, const char *tag, size_t count, size_t size,
+                      void **out)
+{
+    *out = NULL;
+    if (size && count > SIZE_MAX / size)
+        return GP_EPARSE;
+    void *p = malloc(count * size > 0 ? count * size : 1);
+    if (!p)
+        return GP_ENOMEM;
+    int rc = count ? read(ctx, tag, 0, p, count * size) : 0;
+    if (rc) {
+        free(p);
+        return rc;
+    }
+    *out = p;
+    return 0;
+}
+
+/* The polyhedra's arrays: offsets from the stored sizes, checked against the summary. */
+static int read_cells3d(gp_result3d *r, gp_section_read_fn read, void *ctx)
+{
+    gp_cells3d *c = &r->cells;
+    size_t n = c->count, nfaces = r->cell_stats.faces, nverts = r->cell_stats.vertices;
+    uint32_t *sizes = NULL, *face_sizes = NULL;
+    int rc = read_whole(read, ctx, GP_SECTION_CELL3D_SIZES, n, 2 * sizeof(uint32_t), (void **)&sizes);
+    if (!rc)
+        rc = read_whole(read, ctx, GP_SECTION_CELL3D_FACE_SIZES, nfaces, sizeof(uint32_t),
+                        (void **)&face_sizes);
+    if (!rc && (!(c->vstart = malloc((n + 1) * sizeof *c->vstart)) ||
+                !(c->fstart = malloc((n + 1) * sizeof *c->fstart)) ||
+                !(c->fvstart = malloc((nfaces + 1) * sizeof *c->fvstart))))
+        rc = GP_ENOMEM;
+    if (!rc) {
+        c->vstart[0] = c->fstart[0] = c->fvstart[0] = 0;
+        for (size_t i = 0; i < n; i++) {
+            c->vstart[i + 1] = c->vstart[i] + sizes[2 * i];
+            c->fstart[i + 1] = c->fstart[i] + sizes[2 * i + 1];
+        }
+        for (size_t f = 0; f < nfaces; f++)
+            c->fvstart[f + 1] = c->fvstart[f] + face_sizes[f];
+        if (c->vstart[n] != nverts || c->fstart[n] != nfaces)
+            rc = GP_EPARSE;
+    }
+    free(sizes);
+    free(face_sizes);
+    if (!rc)
+        rc = read_whole(read, ctx, GP_SECTION_CELL3D_FACE_VERTICES, c->fvstart[nfaces],
+                        sizeof(uint32_t), (void **)&c->fverts);
+    if (!rc)
+        rc = read_whole(read, ctx, GP_SECTION_CELL3D_FACE_NEIGHBOURS, nfaces, sizeof(int32_t),
+                        (void **)&c->fneighbour);
+    if (!rc)
+        rc = read_whole(read, ctx, GP_SECTION_CELL3D_XYZ, nverts, 3 * sizeof(double), (void **)&c->xyz);
+    if (!rc)
+        rc = read_whole(read, ctx, GP_SECTION_CELL3D_VOLUME, n, sizeof(double), (void **)&c->volume);
+    /* a corrupt store must not make a writer index out of its arrays */
+    for (size_t i = 0; i < n && !rc; i++)
+        for (size_t f = c->fstart[i]; f < c->fstart[i + 1] && !rc; f++) {
+            int32_t nb = c->fneighbour[f];
+            if (nb < GP_WALL3D(5) || (nb >= 0 && (size_t)nb >= n))
+                rc = GP_EPARSE;
+            for (size_t k = c->fvstart[f]; k < c->fvstart[f + 1] && !rc; k++)
+                if (c->fverts[k] >= c->vstart[i + 1] - c->vstart[i])
+                    rc = GP_EPARSE;
+        }
+    return rc;
+}
+
+int gp_sections_read_result3d(gp_result3d *r, gp_section_read_fn read, void *ctx)
+{
+    size_t n = r->packing.count;
+    if (!r->packing.spheres) {
+        int rc = read_whole(read, ctx, GP_SECTION_SPHERES, n, sizeof(gp_sphere),
+                            (void **)&r->packing.spheres);
+        if (rc)
+            return rc;
+    }
+    if (r->has_balance && !r->balance.F) {
+        int rc = read_whole(read, ctx, GP_SECTION_F, n, sizeof(double), (void **)&r->balance.F);
+        if (rc)
+            return rc;
+        r->balance.count = n;
+    }
+    if (r->has_cells && !r->cells.vstart) {
+        if (r->cells.count != n)
+            return GP_EPARSE;
+        return read_cells3d(r, read, ctx);
+    }
+    return 0;
 }
 
 /* --- the mesh, window by window --- */

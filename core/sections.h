@@ -38,8 +38,22 @@
  *                     attempts, max level, fill volume) and the statistics of the spheres
  *                     (gp_pack_stats: domain_area is the box's volume, the densities are
  *                     volume fractions)
- *   "spheres"         per grain: x, y, z, r, R (f64 each, 40 bytes)
- * The small sections ("pack", "balance", "cells", "mesh", "pack3d") make a result's summary: the statistics
+ *   "spheres"         per grain: x, y, z, r, R (f64 each, 40 bytes; balanced when it ran)
+ *   "balance3d"       the balancing run, in the layout of "balance"
+ *   "F"               per grain: F after balancing (f64, NaN where undefined), as in 2D
+ *   "cells3d"         the polyhedra's summary: count, shrink, the power volumes' sum, the
+ *                     totals of vertices, faces and face vertices, gp_cell3d_stats, and the
+ *                     length of the stored "tess" text
+ *   "cell3d_sizes"    per cell: its vertex and face counts (u32 each)
+ *   "cell3d_face_sizes" per face: its vertex count (u32), cell after cell
+ *   "cell3d_face_neighbours" per face: the grain across it or GP_WALL3D(k) (i32)
+ *   "cell3d_face_vertices" per face vertex: an index into its cell's vertices (u32)
+ *   "cell3d_xyz"      per vertex: x, y, z (f64 each), cell after cell
+ *   "cell3d_volume"   per cell: its volume (f64)
+ *   "tess"            Neper's .tess of the unshrunk power cells, as gp_write_tess writes
+ *                     it (text), rendered by the worker: the shrunk cells cannot give it
+ *                     back, and an HTTP thread does no geometry (docs/3d.md §10)
+ * The small sections ("pack", "balance", "cells", "mesh", "pack3d", "balance3d", "cells3d") make a result's summary: the statistics
  * and everything a writer needs but the per-grain arrays, which a writer reads window by
  * window through gp_sections_source (below) without holding the whole result.
  *
@@ -84,6 +98,15 @@ extern "C" {
 #define GP_SECTION_MESH_VERSION 2
 #define GP_SECTION_PACK3D "pack3d"
 #define GP_SECTION_SPHERES "spheres"
+#define GP_SECTION_BALANCE3D "balance3d"
+#define GP_SECTION_CELLS3D "cells3d"
+#define GP_SECTION_CELL3D_SIZES "cell3d_sizes"
+#define GP_SECTION_CELL3D_FACE_SIZES "cell3d_face_sizes"
+#define GP_SECTION_CELL3D_FACE_NEIGHBOURS "cell3d_face_neighbours"
+#define GP_SECTION_CELL3D_FACE_VERTICES "cell3d_face_vertices"
+#define GP_SECTION_CELL3D_XYZ "cell3d_xyz"
+#define GP_SECTION_CELL3D_VOLUME "cell3d_volume"
+#define GP_SECTION_TESS "tess"
 
 /* The longest tag, with its NUL. */
 #define GP_SECTION_TAG_SIZE 24
@@ -179,6 +202,30 @@ int gp_sections_from_packing3d(const gp_box *box, const gp_packing3d *packing,
 int gp_section_decode_summary3d(const char *tag, uint32_t version, const void *data, size_t size,
                                 gp_summary3d *out);
 void gp_summary3d_free(gp_summary3d *summary);
+
+/* Cuts a whole 3D result into sections: those of gp_sections_from_packing3d, then
+ * "balance3d" and "F" when it balanced, the "cells3d" ones when it made polyhedra, and
+ * `tess` (tess_len bytes, NULL: none) as the "tess" section. The arrays are borrowed from
+ * `result` and `tess`, which must outlive the sections. Returns 0, GP_ENOMEM or
+ * GP_ETOOBIG (a cell with more than 2^32 vertices or faces); nothing left to free then.
+ * Free with gp_sections_free. */
+int gp_sections_from_result3d(const gp_box *box, const gp_result3d *result, const char *tess,
+                              size_t tess_len, gp_section *sections, size_t *n);
+
+/* Decodes the summary sections of a 3D result (raw[0..nraw-1], "pack3d", "balance3d",
+ * "cells3d"; others skipped) into *box and `out` (zeroed first): its counts, statistics,
+ * has_balance and has_cells, every array NULL; *tess_len gets the stored .tess text's
+ * length (0: none). Returns 0, GP_ENOMEM, GP_EPARSE or GP_EINVAL (no "pack3d", unknown
+ * version). `out` owns what is decoded: free with gp_result3d_free. */
+int gp_section_decode_result3d(const gp_section *raw, size_t nraw, gp_box *box, gp_result3d *out,
+                               size_t *tess_len);
+
+/* Reads the arrays of a stored 3D result whole (spheres, F, the polyhedra) into `result`
+ * (decoded by gp_section_decode_result3d) through `read` (ctx its argument), checking
+ * that the cells' counts add up to the summary's totals, that face vertices index their
+ * cell's vertices and that neighbours are grains or walls. Returns 0, GP_ENOMEM, the
+ * reader's code or GP_EPARSE; what it read is owned by `result`. */
+int gp_sections_read_result3d(gp_result3d *result, gp_section_read_fn read, void *ctx);
 
 #ifdef __cplusplus
 }

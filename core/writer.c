@@ -104,6 +104,7 @@ gp_writer *gp_writer_new(gp_format format, const gp_spec *spec, const gp_result 
     case GP_FORMAT_MSH: rc = gp_plan_msh(w); break;
     case GP_FORMAT_INP: rc = gp_plan_inp(w); break;
     case GP_FORMAT_VTU: rc = gp_plan_vtu(w); break;
+    case GP_FORMAT_TESS: break; /* 3D only (io3d.h): GP_EINVAL */
     }
     /* a mesh in memory is read through windows that point into it */
     if (rc == 0 && (gp_format_needs_mesh(format) || format == GP_FORMAT_VTU) && gp_mesh_result_check(result, GP_FORMAT_MSH, NULL) == 0)

@@ -58,16 +58,7 @@ static json_t *validation(const void *s, const gp_config *cfg)
 static int stages(const void *s, const char **out, int cap)
 {
     const gp_spec *spec = s;
-    int n = 0;
-    if (n < cap)
-        out[n++] = "pack";
-    if ((spec->balance_enabled || spec->laguerre_enabled) && n < cap)
-        out[n++] = "triangulation";
-    if (spec->balance_enabled && n < cap)
-        out[n++] = "balance";
-    if (spec->laguerre_enabled && n < cap)
-        out[n++] = "laguerre";
-    return n;
+    return gp_process_stages("pack", spec->balance_enabled, spec->laguerre_enabled, out, cap);
 }
 
 static void free_run(gp_process_run *run)
@@ -143,6 +134,12 @@ static int picture_color(const gp_request *req, int *color, gp_reply *reply)
 static int refuse(gp_request *req, const gp_result *summary, gp_format format, int color,
                   gp_reply *reply)
 {
+    if (format == GP_FORMAT_TESS) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "f=tess is a 3D tessellation; job %s is a pack2d job: json, csv, svg, vtk or "
+                   "vtu%s", req->id, summary->has_mesh ? ", msh or inp" : "");
+        return -1;
+    }
     if (color == GP_PICTURE_COLOR_QUALITY && !summary->has_balance) {
         gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
                    "color=quality colours the grains by F, which only a job that balances has; "
@@ -160,7 +157,7 @@ static int refuse(gp_request *req, const gp_result *summary, gp_format format, i
 
 static int serves(gp_format format, int has_mesh)
 {
-    return !gp_format_needs_mesh(format) || has_mesh;
+    return format != GP_FORMAT_TESS && (!gp_format_needs_mesh(format) || has_mesh);
 }
 
 static int results(gp_request *req, gp_stored_result *res, gp_format format, gp_reply *reply)

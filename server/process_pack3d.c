@@ -1,15 +1,17 @@
-/* process_pack3d.c - the "pack3d" process (processes.h, docs/3d.md): spheres in a walled
- * box by the 3D advancing front, stored as the "pack3d" and "spheres" sections and served
- * from them as CSV (x,y,z,r,R) or JSON (inputs, statistics, spheres). The stages after
- * packing (balancing, Laguerre polyhedra) and their formats slot in here as they come. */
+/* process_pack3d.c - the "pack3d" process (processes.h, docs/3d.md §10): spheres in a
+ * walled box by the 3D advancing front, balanced and cut into Laguerre polyhedra when the
+ * spec asks (gp_pipeline3d_run), stored as sections (sections.h) with the .tess text the
+ * worker renders, and served from them as CSV, JSON, VTU, tess or the section's SVG. */
 #include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "download.h"
 #include "embedded.h"
+#include "grainpack/io3d.h"
 #include "grainpack/pipeline3d.h"
 #include "grainpack/spec3d.h"
 #include "json_values.h"
@@ -32,21 +34,6 @@ static int parse(const char *text, size_t len, const gp_spec_limits *limits, voi
     if (rc) {
         free(spec);
         return rc;
-    }
-    /* The service stores a 3D job's spheres and their statistics only: a balanced or
-     * tessellated result would be run and then served without what was asked for. */
-    const char *stage = spec->balance_enabled ? "balance" : spec->laguerre_enabled ? "laguerre" : NULL;
-    if (stage) {
-        json_t *doc = json_loadb(text, len, 0, NULL);
-        int wrapped = json_is_object(json_object_get(doc, "inputs"));
-        json_decref(doc);
-        char pointer[32];
-        snprintf(pointer, sizeof pointer, "%s/%s", wrapped ? "/inputs" : "", stage);
-        gp_spec3d_free(spec);
-        free(spec);
-        return gp_error_set(err, GP_EINVAL, pointer,
-                            "the service's pack3d packs only for now: '%s' runs from the command "
-                            "line (grainpack run)", stage);
     }
     *out = spec;
     return 0;
@@ -87,13 +74,11 @@ static json_t *validation(const void *s, const gp_config *cfg)
     return body;
 }
 
-static int stages(const void *spec, const char **out, int cap)
+static int stages(const void *s, const char **out, int cap)
 {
-    (void)spec;
-    if (cap < 1)
-        return 0;
-    out[0] = "pack3d"; /* the stage gp_pack3d reports its progress as */
-    return 1;
+    const gp_spec3d *spec = s;
+    /* "pack3d": the stage gp_pack3d reports its progress as */
+    return gp_process_stages("pack3d", spec->balance_enabled, spec->laguerre_enabled, out, cap);
 }
 
 /* A run's own result: what the sections borrow from. */
@@ -101,6 +86,8 @@ typedef struct pack3d_state {
     gp_box box;
     gp_result3d result;
     gp_pack_stats stats; /* result's statistics as the store takes them (bins borrowed) */
+    gp_out tess;         /* memory mode: the .tess text (with cells and when it welded) */
+    int has_tess;
 } pack3d_state;
 
 static void free_run(gp_process_run *run)
@@ -109,9 +96,43 @@ static void free_run(gp_process_run *run)
     gp_sections_free(run->sections, run->nsections);
     if (st) {
         gp_result3d_free(&st->result);
+        gp_out_free(&st->tess);
         free(st);
     }
     memset(run, 0, sizeof *run);
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* Renders the .tess of the result's power cells into st->tess, here on the worker: a
+ * shrunk result needs its power cells built again, geometry no HTTP thread does
+ * (docs/3d.md §10). A tessellation that does not weld (GP_EGEOM, which the command line
+ * reports as its error too) leaves the job's other formats: it is logged and no "tess"
+ * is stored. Returns 0, GP_ENOMEM or GP_ECANCELED with err set. */
+static int render_tess(const gp_spec3d *spec, const gp_progress *progress, pack3d_state *st,
+                       gp_error *err)
+{
+    double t = now_seconds();
+    if (gp_canceled(gp_progress_cancel(progress)))
+        return gp_error_set(err, GP_ECANCELED, NULL, "canceled after the polyhedra");
+    if (gp_out_init(&st->tess, 0, NULL, NULL))
+        return gp_error_set(err, GP_ENOMEM, "", "out of memory");
+    gp_error why = {0};
+    int rc = gp_write_result3d(&st->tess, GP_FORMAT3D_TESS, spec, &st->result, &why);
+    if (rc == GP_ENOMEM)
+        return gp_error_set(err, GP_ENOMEM, "", "out of memory for the tessellation");
+    st->has_tess = rc == 0;
+    if (rc)
+        gp_log("pack3d: no .tess stored (%s): %s", gp_strerror(rc), why.message);
+    gp_result3d *r = &st->result;
+    if (r->ntimings < GP_MAX_STAGES)
+        r->timings[r->ntimings++] = (gp_stage_time){"tess", now_seconds() - t};
+    return 0;
 }
 
 static int run(void *s, const gp_config *cfg, const gp_progress *progress, gp_process_run *out,
@@ -127,9 +148,13 @@ static int run(void *s, const gp_config *cfg, const gp_progress *progress, gp_pr
     /* the sphere cap is the daemon's --max-disks, as the spec's estimate was checked
      * against it: a packing that outgrows the estimate stops there */
     int rc = gp_pipeline3d_run(spec, cfg->max_disks, progress, &st->result, err);
-    if (rc == 0 && gp_sections_from_packing3d(&st->box, &st->result.packing, &st->result.stats,
-                                              out->sections, &out->nsections))
-        rc = gp_error_set(err, GP_ENOMEM, "", "out of memory");
+    if (rc == 0 && st->result.has_cells)
+        rc = render_tess(spec, progress, st, err);
+    if (rc == 0 && (rc = gp_sections_from_result3d(&st->box, &st->result,
+                                                   st->has_tess ? st->tess.buf : NULL,
+                                                   st->tess.len, out->sections, &out->nsections)))
+        rc = gp_error_set(err, rc, "", "the result cannot be cut into sections: %s",
+                          gp_strerror(rc));
     if (rc) {
         free_run(out);
         return rc;
@@ -143,42 +168,60 @@ static int run(void *s, const gp_config *cfg, const gp_progress *progress, gp_pr
     return 0;
 }
 
+/* The formats every pack3d job is served in: its spheres (csv, json), its polyhedra or its
+ * spheres (vtu), the section picture (svg). tess is served too, to a job that made
+ * polyhedra; the links, which know no more of a job than whether its spec asked for a
+ * mesh, do not list it. */
 static int serves(gp_format format, int has_mesh)
 {
     (void)has_mesh;
-    return format == GP_FORMAT_JSON || format == GP_FORMAT_CSV;
+    return format == GP_FORMAT_JSON || format == GP_FORMAT_CSV || format == GP_FORMAT_VTU ||
+           format == GP_FORMAT_SVG;
 }
 
-/* The stored summary of a 3D result (decoded from its "pack3d" section). Returns 0 or
- * the decoder's code. */
-static int stored_summary(const gp_stored_result *res, gp_summary3d *out)
+/* The stored summary of a 3D result: counts and statistics, arrays NULL (sections.h). */
+typedef struct stored3d {
+    gp_box box;
+    gp_result3d result; /* owned */
+    size_t tess_len;    /* bytes of the stored .tess text (0: none) */
+} stored3d;
+
+static int stored_summary(const gp_stored_result *res, stored3d *out)
 {
-    for (size_t i = 0; i < res->nraw; i++)
-        if (strcmp(res->raw[i].tag, GP_SECTION_PACK3D) == 0)
-            return gp_section_decode_summary3d(res->raw[i].tag, res->raw[i].version,
-                                               res->raw[i].data, res->raw[i].size, out);
-    memset(out, 0, sizeof *out);
-    return GP_EPARSE;
+    return gp_section_decode_result3d(res->raw, res->nraw, &out->box, &out->result, &out->tess_len);
 }
 
-/* The statistics document of a 3D result, as gp_write_json3d writes it (io_json3d.c):
+/* The statistics document of a 3D result, as gp_write_json3d writes its "statistics":
  * the spheres' densities (volume fractions), radii and joints, the law's bins and how the
- * front went. NULL when out of memory. */
-static json_t *summary_json(const gp_summary3d *sum, uint64_t seed)
+ * front went; then (not in the JSON download's "statistics", which has them beside it)
+ * "balance" and "cells" when they ran. NULL when out of memory. */
+static json_t *summary_json(const gp_result3d *r, uint64_t seed, int stages)
 {
-    const gp_pack3d_stats *st = &sum->stats;
-    const gp_packing3d *pk = &sum->packing;
+    const gp_pack3d_stats *st = &r->stats;
+    const gp_packing3d *pk = &r->packing;
     gp_pack_stats view = gp_pack3d_stats_view(st);
-    return json_pack("{s:I, s:f, s:f, s:f, s:{s:f, s:f, s:f}, s:{s:f, s:f}, s:o*, "
-                     "s:{s:I, s:I, s:I, s:I}, s:I}",
-                     "count", (json_int_t)st->count, "box_volume", st->box_volume,
-                     "packing_density", st->packing_density, "grain_fraction", st->grain_fraction,
-                     "radius", "min", st->r_min, "max", st->r_max, "mean", st->r_mean, "joint",
-                     "min", st->joint_min, "max", st->joint_max, "distribution",
-                     gp_distribution_stats_json(&view), "front", "wall_spheres",
-                     (json_int_t)pk->wall_spheres, "triangles", (json_int_t)pk->triangles,
-                     "attempts", (json_int_t)pk->attempts, "max_level", (json_int_t)pk->max_level,
-                     "seed", (json_int_t)seed);
+    json_t *o = json_pack("{s:I, s:f, s:f, s:f, s:{s:f, s:f, s:f}, s:{s:f, s:f}, s:o*, "
+                          "s:{s:I, s:I, s:I, s:I}, s:I}",
+                          "count", (json_int_t)st->count, "box_volume", st->box_volume,
+                          "packing_density", st->packing_density, "grain_fraction",
+                          st->grain_fraction, "radius", "min", st->r_min, "max", st->r_max, "mean",
+                          st->r_mean, "joint", "min", st->joint_min, "max", st->joint_max,
+                          "distribution", gp_distribution_stats_json(&view), "front",
+                          "wall_spheres", (json_int_t)pk->wall_spheres, "triangles",
+                          (json_int_t)pk->triangles, "attempts", (json_int_t)pk->attempts,
+                          "max_level", (json_int_t)pk->max_level, "seed", (json_int_t)seed);
+    int failed = !o;
+    if (o && stages && r->has_balance &&
+        json_object_set_new(o, "balance", gp_json_balance(&r->balance, &failed)))
+        failed = 1;
+    if (o && stages && r->has_cells &&
+        json_object_set_new(o, "cells", gp_json_cells3d(&r->cells, &r->cell_stats, &failed)))
+        failed = 1;
+    if (failed) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
 }
 
 /* The job's spec as stored, parsed again without today's caps (it was accepted once). */
@@ -189,17 +232,18 @@ static int stored_spec(const gp_stored_result *res, gp_spec3d *spec)
     return gp_spec3d_parse(res->spec_text, res->spec_len, &unlimited, spec, &err);
 }
 
-/* The statistics of a stored result, and its inputs when `inputs` is not NULL. */
-static json_t *stored_statistics(const gp_stored_result *res, json_t **inputs)
+/* The statistics of a stored result (with its stages' when `stages`), and its inputs
+ * when `inputs` is not NULL. */
+static json_t *stored_statistics(const gp_stored_result *res, int stages, json_t **inputs)
 {
     gp_spec3d spec;
-    gp_summary3d sum;
+    stored3d sum;
     if (stored_spec(res, &spec))
         return NULL;
     json_t *stats = NULL;
     if (stored_summary(res, &sum) == 0) {
-        stats = summary_json(&sum, spec.seed);
-        gp_summary3d_free(&sum);
+        stats = summary_json(&sum.result, spec.seed, stages);
+        gp_result3d_free(&sum.result);
     }
     if (stats && inputs && !(*inputs = gp_spec3d_json(&spec))) {
         json_decref(stats);
@@ -211,7 +255,7 @@ static json_t *stored_statistics(const gp_stored_result *res, json_t **inputs)
 
 static json_t *statistics(const gp_stored_result *res)
 {
-    return stored_statistics(res, NULL);
+    return stored_statistics(res, 1, NULL);
 }
 
 /* A download of the spheres: CSV rows, or the JSON document's "spheres" array after its
@@ -294,7 +338,7 @@ static int spheres_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_ou
     return t->done ? 0 : 1;
 }
 
-/* The renderer of res in format (CSV or JSON). Returns 0, GP_ENOMEM or the decoder's code. */
+/* The renderer of res's spheres in format (CSV, or JSON of a job that only packed). Returns 0, GP_ENOMEM or the decoder's code. */
 static int spheres_renderer(const gp_stored_result *res, gp_format format,
                             gp_download_renderer *out)
 {
@@ -302,15 +346,15 @@ static int spheres_renderer(const gp_stored_result *res, gp_format format,
     if (!t)
         return GP_ENOMEM;
     t->format = format;
-    gp_summary3d sum;
+    stored3d sum;
     int rc = stored_summary(res, &sum);
     if (rc) {
         free(t);
         return rc;
     }
-    t->count = sum.packing.count;
-    gp_summary3d_free(&sum);
-    if (format == GP_FORMAT_JSON && !(t->stats = stored_statistics(res, &t->inputs))) {
+    t->count = sum.result.packing.count;
+    gp_result3d_free(&sum.result);
+    if (format == GP_FORMAT_JSON && !(t->stats = stored_statistics(res, 0, &t->inputs))) {
         spheres_text_free(t);
         return GP_ENOMEM;
     }
@@ -318,23 +362,156 @@ static int spheres_renderer(const gp_stored_result *res, gp_format format,
     return 0;
 }
 
+/* A download of the stored .tess text, copied window by window. */
+typedef struct tess_text {
+    size_t len, next;
+    char window[GP_STORE_CHUNK];
+} tess_text;
+
+static int tess_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text, size_t want)
+{
+    tess_text *t = ctx;
+    while (t->next < t->len && text->len < want) {
+        size_t n = t->len - t->next < sizeof t->window ? t->len - t->next : sizeof t->window;
+        int rc = read(read_ctx, GP_SECTION_TESS, (uint64_t)t->next, t->window, n);
+        if (rc)
+            return rc;
+        gp_out_write(text, t->window, n);
+        t->next += n;
+    }
+    return t->next < t->len;
+}
+
+/* A download rendered whole by the command line's writer (gp_write_result3d) from the
+ * arrays read whole: the polyhedra's formats, whose vertices a writer reaches from every
+ * part of its output (vtu's connectivity then faces, the picture's cut of every cell),
+ * and a balanced or tessellated job's JSON. Holds the result, then its text, at once
+ * (docs/3d.md §10 measures it). */
+typedef struct whole_text {
+    gp_spec3d spec;
+    gp_result3d result; /* the summary, then the arrays: dropped once rendered */
+    gp_format3d format;
+    gp_out out;         /* memory mode: the whole text */
+    size_t pos;         /* bytes of it handed on */
+    int rendered;
+} whole_text;
+
+static void whole_text_free(void *ctx)
+{
+    whole_text *t = ctx;
+    gp_spec3d_free(&t->spec);
+    gp_result3d_free(&t->result);
+    gp_out_free(&t->out);
+    free(t);
+}
+
+static int whole_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text, size_t want)
+{
+    whole_text *t = ctx;
+    if (!t->rendered) {
+        int rc = gp_sections_read_result3d(&t->result, read, read_ctx);
+        if (rc)
+            return rc;
+        if (gp_out_init(&t->out, 0, NULL, NULL))
+            return GP_ENOMEM;
+        gp_error err = {0};
+        rc = gp_write_result3d(&t->out, t->format, &t->spec, &t->result, &err);
+        gp_result3d_free(&t->result);
+        if (rc)
+            return rc;
+        t->rendered = 1;
+    }
+    size_t room = want > text->len ? want - text->len : 0, left = t->out.len - t->pos;
+    size_t n = left < room ? left : room;
+    gp_out_write(text, t->out.buf + t->pos, n);
+    t->pos += n;
+    return t->pos < t->out.len;
+}
+
+/* The renderer of res in `format` (its summary decoded in `sum`, taken over). Returns 0,
+ * GP_ENOMEM or the decoder's code. */
+static int renderer_of(const gp_stored_result *res, stored3d *sum, gp_format format,
+                       gp_download_renderer *out)
+{
+    const gp_result3d *r = &sum->result;
+    if (format == GP_FORMAT_CSV ||
+        (format == GP_FORMAT_JSON && !r->has_balance && !r->has_cells)) {
+        gp_result3d_free(&sum->result);
+        return spheres_renderer(res, format, out);
+    }
+    if (format == GP_FORMAT_TESS) {
+        tess_text *t = calloc(1, sizeof *t);
+        gp_result3d_free(&sum->result);
+        if (!t)
+            return GP_ENOMEM;
+        t->len = sum->tess_len;
+        *out = (gp_download_renderer){t, tess_run, free};
+        return 0;
+    }
+    whole_text *t = calloc(1, sizeof *t);
+    if (!t) {
+        gp_result3d_free(&sum->result);
+        return GP_ENOMEM;
+    }
+    t->result = sum->result;
+    memset(&sum->result, 0, sizeof sum->result);
+    t->format = format == GP_FORMAT_JSON  ? GP_FORMAT3D_JSON
+                : format == GP_FORMAT_VTU ? GP_FORMAT3D_VTU
+                                          : GP_FORMAT3D_SVG;
+    int rc = stored_spec(res, &t->spec);
+    if (rc) {
+        gp_result3d_free(&t->result);
+        free(t);
+        return rc;
+    }
+    *out = (gp_download_renderer){t, whole_run, whole_text_free};
+    return 0;
+}
+
+/* Why the stored result cannot be served in `format`, as a 400 in reply; 0 when it can. */
+static int refuse(gp_request *req, const stored3d *sum, gp_format format, gp_reply *reply)
+{
+    if (format == GP_FORMAT_TESS && !sum->result.has_cells) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "f=tess is the Laguerre tessellation; job %s made no polyhedra (its spec has "
+                   "no \"laguerre\"): json, csv, vtu or svg", req->id);
+        return -1;
+    }
+    if (format == GP_FORMAT_TESS && sum->tess_len == 0) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "job %s has no .tess: its power cells did not weld into a tessellation "
+                   "(the daemon's log says why): json, csv, vtu or svg", req->id);
+        return -1;
+    }
+    if (format != GP_FORMAT_TESS && !serves(format, 0)) {
+        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
+                   "f=%s is not offered for a pack3d job: json, csv, vtu, svg, or tess (with "
+                   "polyhedra)", gp_format_name(format));
+        return -1;
+    }
+    return 0;
+}
+
 static int results(gp_request *req, gp_stored_result *res, gp_format format, gp_reply *reply)
 {
-    if (!serves(format, 0)) {
-        gp_problem(reply, 400, GP_PROBLEM_BAD_PARAMETER, req->path,
-                   "f=%s is not offered for a pack3d job yet: json or csv", gp_format_name(format));
+    stored3d sum;
+    int rc = stored_summary(res, &sum);
+    if (rc == 0 && refuse(req, &sum, format, reply)) {
+        gp_result3d_free(&sum.result);
         gp_stored_result_free(res);
         return GP_ROUTE_DONE;
     }
     int gzip = gp_format_is_text(format) && gp_render_accepts_gzip(req);
     char etag[GP_ETAG_SIZE];
     gp_render_etag(res, NULL, format, gzip, etag);
-    if (gp_download_headers(req, etag, gp_format_name(format), gzip, reply)) {
+    if (rc == 0 && gp_download_headers(req, etag, gp_format_name(format), gzip, reply)) {
+        gp_result3d_free(&sum.result);
         gp_stored_result_free(res);
         return GP_ROUTE_DONE;
     }
     gp_download_renderer renderer;
-    int rc = spheres_renderer(res, format, &renderer);
+    if (rc == 0)
+        rc = renderer_of(res, &sum, format, &renderer);
     if (rc) {
         gp_stored_result_free(res);
         if (rc == GP_ENOMEM)

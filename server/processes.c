@@ -52,3 +52,14 @@ int gp_process_parse_request(const gp_process_def *p, gp_request *req, void **sp
     }
     return 0;
 }
+
+int gp_process_stages(const char *pack, int balance, int laguerre, const char **out, int cap)
+{
+    const char *all[] = {pack, balance || laguerre ? "triangulation" : NULL,
+                         balance ? "balance" : NULL, laguerre ? "laguerre" : NULL};
+    int n = 0;
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        if (all[i] && n < cap)
+            out[n++] = all[i];
+    return n;
+}

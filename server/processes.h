@@ -64,6 +64,12 @@ typedef struct gp_process_def {
     json_t *(*statistics)(const gp_stored_result *res);
 } gp_process_def;
 
+/* The stages of a packing process's run as its `stages` lists them: `pack` (the stage
+ * its packer reports as), then "triangulation", "balance" and "laguerre" as the spec asks
+ * (both processes' pipelines run them on one regular triangulation). Returns how many
+ * (at most cap). */
+int gp_process_stages(const char *pack, int balance, int laguerre, const char **out, int cap);
+
 /* The processes, in the order /processes lists them. */
 extern const gp_process_def gp_process_pack2d;
 extern const gp_process_def gp_process_pack3d;

@@ -3,11 +3,13 @@
  * when it reads the per-grain arrays from the sections window by window (windows of a few
  * grains, so that every cell boundary falls on one), and when it is stopped and resumed
  * every few bytes. Corrupt or truncated sections are refused, not read past. A 3D
- * packing's sections read back the same way. */
+ * packing's sections read back the same way, and a balanced, tessellated 3D result's give
+ * every 3D writer its bytes in memory. */
 #include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
+#include "grainpack/io3d.h"
 #include "grainpack/pipeline3d.h"
 #include "json_values.h"
 #include "sections.h"
@@ -42,6 +44,13 @@ static void unstore(stored *st)
     for (size_t i = 0; i < st->n; i++)
         free(st->copy[i]);
     gp_sections_free(st->sections, st->n);
+}
+
+/* Frees the copies only (the sections are the caller's). */
+static void unstore_copies(stored *st)
+{
+    for (size_t i = 0; i < st->n; i++)
+        free(st->copy[i]);
 }
 
 static int read_stored(void *ctx, const char *tag, uint64_t offset, void *dst, size_t len)
@@ -129,8 +138,9 @@ static void check_every_format(const char *label, const gp_spec *spec, const gp_
      * boundary; 0: the defaults */
     const size_t windows[] = {7, 0};
     for (int f = 0; f < (int)gp_format_count(); f++) {
-        /* msh and inp exist only with a mesh; the mesh's SVG draws it read whole */
-        if (gp_format_needs_mesh((gp_format)f) && !r->has_mesh)
+        /* msh and inp exist only with a mesh, tess in 3D only; the mesh's SVG draws it
+         * read whole */
+        if ((gp_format_needs_mesh((gp_format)f) && !r->has_mesh) || f == GP_FORMAT_TESS)
             continue;
         if (f == GP_FORMAT_SVG && r->has_mesh && !summary.mesh.xy) {
             CHECK(gp_sections_read_mesh(&summary, read_stored, &st) == 0);
@@ -474,9 +484,127 @@ static void test_pack3d_sections(void)
     gp_spec3d_free(&spec);
 }
 
+/* The sections of `n` copied into `st`, as a store would hold them. */
+static void store_sections(stored *st, const gp_section *sec, size_t n)
+{
+    memset(st, 0, sizeof *st);
+    st->n = n;
+    for (size_t i = 0; i < n; i++) {
+        st->sections[i] = sec[i];
+        st->sections[i].owned = NULL; /* the caller's to free */
+        st->copy[i] = malloc(sec[i].size + 1);
+        memcpy(st->copy[i], sec[i].data, sec[i].size);
+    }
+}
+
+/* The text of `result` in `format`, written in memory; *len its length. */
+static char *render3d(gp_format3d format, const gp_spec3d *spec, const gp_result3d *result, size_t *len)
+{
+    gp_out o;
+    gp_error err;
+    CHECK(gp_out_init(&o, 0, NULL, NULL) == 0);
+    CHECK_MSG(gp_write_result3d(&o, format, spec, result, &err) == 0, "%s: %s",
+              gp_format3d_name(format), err.message);
+    *len = o.len;
+    return o.buf; /* the caller frees it */
+}
+
+/* A balanced, tessellated 3D result cut into sections, the summary decoded and the
+ * arrays read back: every format writes the same bytes from them as from the result in
+ * memory, the stored .tess is the text it was given, and a face vertex or neighbour out
+ * of range, truncated sizes or a truncated summary are refused. */
+static void test_result3d_sections(void)
+{
+    gp_spec3d spec;
+    gp_error err;
+    const char *text = "{\"inputs\": {\"domain\": {\"width\": 6, \"height\": 5, \"depth\": 4},"
+                       " \"distribution\": {\"kind\": \"uniform\", \"min\": 0.4, \"max\": 0.8},"
+                       " \"joint\": {\"law\": \"constant\", \"value\": 0.05}, \"seed\": 5,"
+                       " \"balance\": {\"method\": \"relocation\"}, \"laguerre\": {\"shrink\": \"offset\"},"
+                       " \"picture\": {\"section\": {\"axis\": \"x\", \"at\": 0.3}}}}";
+    CHECK_MSG(gp_spec3d_parse(text, strlen(text), NULL, &spec, &err) == 0, "%s", err.message);
+    gp_result3d r;
+    CHECK_MSG(gp_pipeline3d_run(&spec, 0, NULL, &r, &err) == 0, "%s", err.message);
+    CHECK(r.has_balance && r.has_cells && r.packing.count > 20);
+    size_t tess_len;
+    char *tess = render3d(GP_FORMAT3D_TESS, &spec, &r, &tess_len);
+    gp_section sec[GP_SECTIONS_MAX];
+    size_t n;
+    CHECK(gp_sections_from_result3d(&spec.box, &r, tess, tess_len, sec, &n) == 0 && n == 12);
+    stored st;
+    store_sections(&st, sec, n);
+    gp_section raw[GP_SECTIONS_MAX];
+    size_t nraw = 0;
+    for (size_t i = 0; i < n; i++)
+        if (sec[i].summary)
+            raw[nraw++] = sec[i];
+    CHECK(nraw == 3);
+    gp_box box;
+    gp_result3d back;
+    size_t stored_tess;
+    CHECK(gp_section_decode_result3d(raw, nraw, &box, &back, &stored_tess) == 0);
+    CHECK(back.has_balance && back.has_cells && stored_tess == tess_len && !back.packing.spheres &&
+          !back.cells.vstart && back.cell_stats.faces == r.cell_stats.faces &&
+          back.balance.after.max == r.balance.after.max && back.balance.sweeps == r.balance.sweeps);
+    CHECK(memcmp(&box, &spec.box, sizeof box) == 0);
+    CHECK(gp_sections_read_result3d(&back, read_stored, &st) == 0);
+    const gp_format3d formats[] = {GP_FORMAT3D_CSV, GP_FORMAT3D_JSON, GP_FORMAT3D_VTU, GP_FORMAT3D_SVG};
+    for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++) {
+        size_t a, b;
+        char *want = render3d(formats[k], &spec, &r, &a);
+        char *got = render3d(formats[k], &spec, &back, &b);
+        CHECK_MSG(a == b && memcmp(want, got, a) == 0, "%s: %zu bytes from the sections, %zu in memory",
+                  gp_format3d_name(formats[k]), b, a);
+        free(want);
+        free(got);
+    }
+    char *tess_back = malloc(tess_len);
+    CHECK(read_stored(&st, GP_SECTION_TESS, 0, tess_back, tess_len) == 0 &&
+          memcmp(tess_back, tess, tess_len) == 0);
+    free(tess_back);
+    gp_result3d_free(&back);
+
+    /* corrupt arrays: each read is refused, not indexed past */
+    for (int corruption = 0; corruption < 3; corruption++) {
+        stored bad;
+        store_sections(&bad, sec, n);
+        for (size_t i = 0; i < n; i++) {
+            if (corruption == 0 && strcmp(sec[i].tag, GP_SECTION_CELL3D_FACE_VERTICES) == 0)
+                ((uint32_t *)bad.copy[i])[0] = 1000000;
+            if (corruption == 1 && strcmp(sec[i].tag, GP_SECTION_CELL3D_FACE_NEIGHBOURS) == 0)
+                ((int32_t *)bad.copy[i])[0] = (int32_t)r.packing.count;
+            if (corruption == 2 && strcmp(sec[i].tag, GP_SECTION_CELL3D_SIZES) == 0)
+                ((uint32_t *)bad.copy[i])[0] += 1;
+        }
+        CHECK(gp_section_decode_result3d(raw, nraw, &box, &back, &stored_tess) == 0);
+        CHECK_MSG(gp_sections_read_result3d(&back, read_stored, &bad) == GP_EPARSE, "corruption %d",
+                  corruption);
+        gp_result3d_free(&back);
+        unstore_copies(&bad);
+    }
+    /* every truncation of the summaries is refused */
+    size_t refused = 0, cuts = 0;
+    for (size_t i = 0; i < nraw; i++) {
+        gp_section cut = raw[i];
+        for (cut.size = 0; cut.size < raw[i].size; cut.size++, cuts++) {
+            gp_section trial[3];
+            memcpy(trial, raw, sizeof trial);
+            trial[i] = cut;
+            refused += gp_section_decode_result3d(trial, nraw, &box, &back, &stored_tess) == GP_EPARSE;
+        }
+    }
+    CHECK_MSG(refused == cuts, "%zu of %zu truncations refused", refused, cuts);
+    unstore_copies(&st);
+    gp_sections_free(sec, n);
+    free(tess);
+    gp_result3d_free(&r);
+    gp_spec3d_free(&spec);
+}
+
 int main(void)
 {
     RUN(test_pack3d_sections);
+    RUN(test_result3d_sections);
     RUN(test_every_format_reads_the_same_from_sections);
     RUN(test_mesh_from_sections);
     RUN(test_mesh_sections_refused);

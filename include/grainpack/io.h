@@ -29,11 +29,12 @@ typedef enum gp_format {
     GP_FORMAT_VTK,
     GP_FORMAT_MSH, /* the mesh: Gmsh MSH 4.1 (io_mesh.h) */
     GP_FORMAT_INP, /* the mesh: Abaqus input */
-    GP_FORMAT_VTU  /* the mesh, or the grains without one: VTK XML unstructured grid */
+    GP_FORMAT_VTU, /* the mesh, or the grains without one: VTK XML unstructured grid */
+    GP_FORMAT_TESS /* a 3D job's tessellation (Neper's .tess, io3d.h): no 2D writer has it */
 } gp_format;
 
-/* Maps "json", "csv", "svg", "vtk", "msh", "inp" or "vtu" to a format; returns 0 or
- * GP_EINVAL. */
+/* Maps "json", "csv", "svg", "vtk", "msh", "inp", "vtu" or "tess" to a format; returns 0
+ * or GP_EINVAL. */
 GP_API int gp_format_parse(const char *name, gp_format *out);
 GP_API const char *gp_format_name(gp_format format);
 /* How many formats there are: every value from 0 to gp_format_count() - 1 is a format,

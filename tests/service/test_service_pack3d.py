@@ -8,7 +8,8 @@ it serves, and its CSV download, read back by Python's csv module, has spheres t
 overlap no other (relative 1e-9, the engine's tolerance), lie in the box, and give the
 statistics' count, packing density and bin counts; the JSON download holds the same
 spheres and statistics, the gzip download the same bytes, and none of the downloads runs
-the pipeline again; a format it does not serve is 400. A pack3d job too large for
+the pipeline again; a format it does not serve (msh) is 400 (its balanced, tessellated
+jobs: test_service_pack3d_cells.py). A pack3d job too large for
 --max-disks is refused before it is stored, one past --max-job-seconds fails with a time
 limit, a dismissed one stops, and a finished one is deleted with its results. Responses
 are checked against openapi.yaml. The JSON and CSV downloads are byte for byte what
@@ -57,10 +58,8 @@ def bad_specs():
     return [
         ("a negative depth", "pack3d", negative, "/inputs/domain/depth"),
         ("a box without depth", "pack3d", flat, "/inputs/domain/depth"),
-        # the command line runs these; the service stores and serves the spheres only
-        ("a balancing asked of the service's pack3d", "pack3d", spec3d(balance={"method": "relocation"}), "/inputs/balance"),
-        ("polyhedra asked of the service's pack3d", "pack3d", spec3d(laguerre={"shrink": "offset"}),
-         "/inputs/laguerre"),
+        ("an unknown balance method", "pack3d", spec3d(balance={"method": "stir"}), "/inputs/balance/method"),
+        ("a shrink that is not one", "pack3d", spec3d(laguerre={"shrink": 2}), "/inputs/laguerre/shrink"),
         ("a sphere larger than the box", "pack3d", big, "/inputs/domain/depth"),
         ("a depth given to pack2d", "pack2d", deep2d, "/inputs/domain/depth"),
     ]
@@ -159,7 +158,7 @@ def check_job(c, api, client, cli):
     api.check(c, "GET", "/jobs/{jobId}", client.get(f"/jobs/{job}"))
     formats = {lk["href"].split("f=")[1] for lk in info["links"]
                if lk["rel"] == RESULTS_REL and "f=" in lk["href"]}
-    c.check(info["processID"] == "pack3d" and formats == {"csv"}, f"status links {sorted(formats)}")
+    c.check(info["processID"] == "pack3d" and formats == {"csv", "svg", "vtu"}, f"status links {sorted(formats)}")
     listed = {j["jobID"]: j["processID"] for j in client.get("/jobs").json()["jobs"]}
     c.check(listed.get(job) == "pack3d", f"/jobs says {listed.get(job)}")
 
@@ -213,8 +212,8 @@ def check_job(c, api, client, cli):
     etag = z.headers.get("etag")
     again = client.get(f"/jobs/{job}/results?f=csv", headers={"Accept-Encoding": "gzip", "If-None-Match": etag})
     c.check(again.status == 304, f"If-None-Match of the gzip CSV: {again.status}")
-    r = client.get(f"/jobs/{job}/results?f=svg")
-    gpd.check_problem(c, r, 400, "urn:grainpack:problem:bad-parameter", "pack3d", "svg of a pack3d job")
+    r = client.get(f"/jobs/{job}/results?f=msh")
+    gpd.check_problem(c, r, 400, "urn:grainpack:problem:bad-parameter", "pack3d", "msh of a pack3d job")
     api.check(c, "GET", "/jobs/{jobId}/results", r)
     c.check(pipeline_runs(client) == runs, "a download ran the pipeline again")
 
