@@ -138,8 +138,14 @@ int gp_result3d_power_cells(const gp_spec3d *spec, const gp_result3d *result, gp
                             gp_error *err)
 {
     gp_laguerre_params none = {GP_SHRINK_NONE, 0};
-    /* the packing is only read: without balancing nothing moves it */
-    return on_triangulation(spec, (gp_packing3d *)&result->packing, NULL, &none, NULL, out, NULL, err);
+    const gp_packing3d *p = &result->packing;
+    gp_rt3 *rt = NULL;
+    int rc = gp_rt3_build(p->spheres, p->count, NULL, &rt, err);
+    if (rc)
+        return rc;
+    rc = gp_laguerre3d(&spec->box, p->spheres, p->count, rt, &none, NULL, out, err);
+    gp_rt3_free(rt);
+    return rc;
 }
 
 void gp_result3d_free(gp_result3d *result)

@@ -3,6 +3,7 @@
  * spec asks (gp_pipeline3d_run), stored as sections (sections.h) with the .tess text the
  * worker renders, and served from them as CSV, JSON, VTU, tess or the section's SVG. */
 #include <jansson.h>
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +24,10 @@
 /* Spheres read from the store at once when a download renders them: 40 KB a window, the
  * order of the text it makes (some 60 bytes a sphere) and of a store chunk. */
 #define WINDOW_SPHERES 1024
+
+/* A whole-rendered download at least this large gives its pages back to the system when
+ * it ends (malloc_trim, a few ms): below, what glibc keeps mapped is not worth the call. */
+#define WHOLE_TRIM_BYTES ((size_t)16 << 20)
 
 static int parse(const char *text, size_t len, const gp_spec_limits *limits, void **out,
                  gp_error *err)
@@ -399,10 +404,15 @@ typedef struct whole_text {
 static void whole_text_free(void *ctx)
 {
     whole_text *t = ctx;
+    int large = t->out.cap >= WHOLE_TRIM_BYTES;
     gp_spec3d_free(&t->spec);
     gp_result3d_free(&t->result);
     gp_out_free(&t->out);
     free(t);
+    /* the arrays and the text went back to malloc's arenas, which glibc keeps mapped (an
+       80 000-sphere VTU left the daemon 135 MB larger, docs/3d.md §10): give them back */
+    if (large)
+        malloc_trim(0);
 }
 
 static int whole_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text, size_t want)
