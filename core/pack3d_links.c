@@ -2,6 +2,7 @@
  * pairs of its links (the nearest spheres and walls within the link gap) that are linked
  * to each other too. */
 #include <math.h>
+#include <string.h>
 
 #include "pack3d_internal.h"
 
@@ -124,6 +125,8 @@ static void closing_spheres(const gp_sphere *sc, const link *a, const link *b, c
         double o = nrm[0] * (s->x - sc->x) + nrm[1] * (s->y - sc->y) + nrm[2] * (s->z - sc->z);
         if (o != 0.0)
             side[o > 0.0] = s->id;
+        if (side[0] != P3_NONE && side[1] != P3_NONE)
+            return; /* closed: which spheres close it does not matter */
     }
 }
 
@@ -143,7 +146,9 @@ int p3_link(p3_packer *pk, int32_t c, int32_t parent)
             }
     }
     parent_members(pk, parent, links, n, member);
-    const int32_t *pm = parent != P3_NONE ? pk->fr.tris[parent].m : NULL;
+    int32_t pm[3] = {P3_NONE, P3_NONE, P3_NONE}; /* a copy: a push below may move the pool */
+    if (parent != P3_NONE)
+        memcpy(pm, pk->fr.tris[parent].m, sizeof pm);
     const gp_sphere *sc = &pk->spheres[c];
     for (int i = 0; i < n; i++)
         for (uint32_t later = adj[i] & ~((2u << i) - 1); later; later &= later - 1) {
