@@ -88,11 +88,12 @@ int p3_overlap(double ax, double ay, double az, double aR, const gp_sphere *b)
     return dx * dx + dy * dy + dz * dz < reach * reach;
 }
 
-/* The first sphere of cell `cell`'s list that overlaps the ball (x, y, z, R), or P3_NONE. */
-static inline int32_t cell_first_overlap(const p3_grid *grid, const gp_sphere *spheres, size_t cell,
+/* The first sphere of the cell list from `s` on that overlaps the ball (x, y, z, R), or
+ * P3_NONE. */
+static inline int32_t list_first_overlap(const p3_grid *grid, const gp_sphere *spheres, int32_t s,
                                          double x, double y, double z, double R)
 {
-    for (int32_t s = grid->head[cell]; s != P3_NONE; s = grid->next[s])
+    for (; s != P3_NONE; s = grid->next[s])
         if (p3_overlap(x, y, z, R, &spheres[s]))
             return s;
     return P3_NONE;
@@ -105,17 +106,17 @@ int32_t p3_grid_first_overlap(const p3_grid *grid, const gp_sphere *spheres, dou
                               double z, double R, double R_max)
 {
     size_t home = cell_index(grid, cell_of(grid, 0, x), cell_of(grid, 1, y), cell_of(grid, 2, z));
-    int32_t s = cell_first_overlap(grid, spheres, home, x, y, z, R);
+    int32_t s = list_first_overlap(grid, spheres, grid->head[home], x, y, z, R);
     if (s != P3_NONE)
         return s;
     int32_t lo[3], hi[3];
     p3_grid_range(grid, x, y, z, R + R_max, lo, hi);
     for (int32_t k = lo[2]; k <= hi[2]; k++)
         for (int32_t j = lo[1]; j <= hi[1]; j++) {
-            size_t row = cell_index(grid, 0, j, k);
+            const int32_t *row = p3_grid_row(grid, j, k);
             for (int32_t i = lo[0]; i <= hi[0]; i++)
-                if (row + (size_t)i != home &&
-                    (s = cell_first_overlap(grid, spheres, row + (size_t)i, x, y, z, R)) != P3_NONE)
+                if (row + i != grid->head + home &&
+                    (s = list_first_overlap(grid, spheres, row[i], x, y, z, R)) != P3_NONE)
                     return s;
         }
     return P3_NONE;

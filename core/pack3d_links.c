@@ -65,8 +65,9 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
     int n = 0;
     for (int32_t k = lo[2]; k <= hi[2]; k++) {
         for (int32_t j = lo[1]; j <= hi[1]; j++) {
+            const int32_t *row = p3_grid_row(grid, j, k);
             for (int32_t i = lo[0]; i <= hi[0]; i++) {
-                for (int32_t q = p3_grid_cell(grid, i, j, k); q != P3_NONE; q = grid->next[q]) {
+                for (int32_t q = row[i]; q != P3_NONE; q = grid->next[q]) {
                     const gp_sphere *o = &pk->spheres[q];
                     double d2 = dist2(s->x, s->y, s->z, o->x, o->y, o->z), reach = link_reach(pk, s->R, o->R);
                     if (d2 < reach * reach && q != c) {
