@@ -86,17 +86,35 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
     return n;
 }
 
-/* Whether links a and b are within the link gap of each other. */
-static int linked(const p3_packer *pk, const link *a, const link *b)
+/* The bit masks adj[] of the links within the link gap of each other (walls across an
+ * axis never). The first ns links are the spheres, the walls follow (gather). */
+static void adjacency(const p3_packer *pk, const link *links, int ns, int n, uint32_t *adj)
 {
-    if (P3_IS_WALL(a->id) && P3_IS_WALL(b->id))
-        return P3_WALL_INDEX(a->id) / 2 != P3_WALL_INDEX(b->id) / 2; /* walls across an axis never */
-    if (P3_IS_WALL(a->id))
-        return wall_gap(pk, b->x, b->y, b->z, b->R, P3_WALL_INDEX(a->id)) < pk->gap * pk->R_max;
-    if (P3_IS_WALL(b->id))
-        return wall_gap(pk, a->x, a->y, a->z, a->R, P3_WALL_INDEX(b->id)) < pk->gap * pk->R_max;
-    double reach = link_reach(pk, a->R, b->R);
-    return dist2(a->x, a->y, a->z, b->x, b->y, b->z) < reach * reach;
+    for (int i = 0; i < n; i++)
+        adj[i] = 0;
+    double wall_reach = pk->gap * pk->R_max;
+    for (int i = 0; i < ns; i++) {
+        const link *a = &links[i];
+        for (int j = i + 1; j < ns; j++) {
+            const link *b = &links[j];
+            double reach = link_reach(pk, a->R, b->R);
+            if (dist2(a->x, a->y, a->z, b->x, b->y, b->z) < reach * reach) {
+                adj[i] |= 1u << j;
+                adj[j] |= 1u << i;
+            }
+        }
+        for (int w = ns; w < n; w++)
+            if (wall_gap(pk, a->x, a->y, a->z, a->R, P3_WALL_INDEX(links[w].id)) < wall_reach) {
+                adj[i] |= 1u << w;
+                adj[w] |= 1u << i;
+            }
+    }
+    for (int v = ns; v < n; v++)
+        for (int w = v + 1; w < n; w++)
+            if (P3_WALL_INDEX(links[v].id) / 2 != P3_WALL_INDEX(links[w].id) / 2) {
+                adj[v] |= 1u << w;
+                adj[w] |= 1u << v;
+            }
 }
 
 /* For each link, its index among the members of triangle `parent` (-1 when it is not
@@ -112,20 +130,20 @@ static void parent_members(const p3_packer *pk, int32_t parent, const link *link
 }
 
 /* The links on each side of the plane of c and spheres a and b that are linked to a, b
- * and c (tetrahedra c a b s), given as the bit mask `common` over links[]: side[0] one
- * below the plane (or P3_NONE), side[1] one above. */
-static void closing_spheres(const gp_sphere *sc, const link *a, const link *b, const link *links,
-                            uint32_t common, int32_t side[2])
+ * and c (tetrahedra c a b s), given as the bit mask `common` over links[] and their
+ * centres relative to c's in rel[]: side[0] one below the plane (or P3_NONE), side[1] one
+ * above. */
+static void closing_spheres(const double (*rel)[3], int a, int b, const link *links, uint32_t common,
+                            int32_t side[2])
 {
     side[0] = side[1] = P3_NONE;
-    double u[3] = {a->x - sc->x, a->y - sc->y, a->z - sc->z};
-    double v[3] = {b->x - sc->x, b->y - sc->y, b->z - sc->z};
+    const double *u = rel[a], *v = rel[b];
     double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
     for (; common; common &= common - 1) {
-        const link *s = &links[__builtin_ctz(common)];
-        double o = nrm[0] * (s->x - sc->x) + nrm[1] * (s->y - sc->y) + nrm[2] * (s->z - sc->z);
+        int k = __builtin_ctz(common);
+        double o = nrm[0] * rel[k][0] + nrm[1] * rel[k][1] + nrm[2] * rel[k][2];
         if (o != 0.0)
-            side[o > 0.0] = s->id;
+            side[o > 0.0] = links[k].id;
         if (side[0] != P3_NONE && side[1] != P3_NONE)
             return; /* closed: which spheres close it does not matter */
     }
@@ -134,23 +152,23 @@ static void closing_spheres(const gp_sphere *sc, const link *a, const link *b, c
 int p3_link(p3_packer *pk, int32_t c, int32_t parent)
 {
     link links[P3_LINKS + P3_WALLS];
-    uint32_t adj[P3_LINKS + P3_WALLS] = {0}, spheres = 0; /* bit masks over links[] */
+    uint32_t adj[P3_LINKS + P3_WALLS]; /* bit masks over links[] */
     int8_t member[P3_LINKS + P3_WALLS];
-    int n = gather(pk, c, links);
-    for (int i = 0; i < n; i++) {
-        if (!P3_IS_WALL(links[i].id))
-            spheres |= 1u << i;
-        for (int j = i + 1; j < n; j++)
-            if (linked(pk, &links[i], &links[j])) {
-                adj[i] |= 1u << j;
-                adj[j] |= 1u << i;
-            }
+    int n = gather(pk, c, links), ns = 0;
+    double rel[P3_LINKS][3]; /* the spheres' centres relative to c's */
+    const gp_sphere *sc = &pk->spheres[c];
+    while (ns < n && !P3_IS_WALL(links[ns].id)) {
+        rel[ns][0] = links[ns].x - sc->x;
+        rel[ns][1] = links[ns].y - sc->y;
+        rel[ns][2] = links[ns].z - sc->z;
+        ns++;
     }
+    uint32_t spheres = (1u << ns) - 1; /* bit mask over links[] */
+    adjacency(pk, links, ns, n, adj);
     parent_members(pk, parent, links, n, member);
     int32_t pm[3] = {P3_NONE, P3_NONE, P3_NONE}; /* a copy: a push below may move the pool */
     if (parent != P3_NONE)
         memcpy(pm, pk->fr.tris[parent].m, sizeof pm);
-    const gp_sphere *sc = &pk->spheres[c];
     for (int i = 0; i < n; i++)
         for (uint32_t later = adj[i] & ~((2u << i) - 1); later; later &= later - 1) {
             int j = __builtin_ctz(later);
@@ -159,7 +177,7 @@ int p3_link(p3_packer *pk, int32_t c, int32_t parent)
                 behind = pm[3 - member[i] - member[j]];
             if (!P3_IS_WALL(a) && !P3_IS_WALL(b)) {
                 int32_t side[2];
-                closing_spheres(sc, &links[i], &links[j], links, adj[i] & adj[j] & spheres, side);
+                closing_spheres((const double(*)[3])rel, i, j, links, adj[i] & adj[j] & spheres, side);
                 if (side[0] != P3_NONE && side[1] != P3_NONE)
                     continue; /* a tetrahedron on either side: closed (docs/3d.md §3) */
                 if (behind == P3_NONE)
