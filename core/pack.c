@@ -37,7 +37,7 @@ static void draw_radius(packer *pk)
 static int grow_disks(packer *pk)
 {
     size_t cap = pk->capacity + pk->capacity / 2 + 64;
-    gp_disk *disks = grow_realloc(pk->disks, cap, sizeof *disks);
+    gp_disk *disks = grow_aligned(pk->disks, pk->count, cap, sizeof *disks);
     if (!disks)
         return GP_ENOMEM;
     pk->disks = disks;
@@ -67,7 +67,7 @@ int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level)
     pk->disks[id] = (gp_disk){x, y, pk->pending_r, pk->pending_R};
     pk->level[id] = level;
     pk->closings[id] = 0;
-    gp_grid_insert(&pk->grid, id, x, y);
+    gp_grid_insert(&pk->grid, id, x, y, pk->pending_R);
     front_disk_added(&pk->fr, id);
     pk->out->fill_area += M_PI * pk->pending_R * pk->pending_R;
     if (level > pk->out->max_level)
@@ -81,7 +81,7 @@ int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, in
 {
     int32_t q = GP_GRID_NONE;
     int ok = gp_domain_contains_disk(pk->params->domain, x, y, R, R * GP_CONTACT_RTOL) &&
-             (q = gp_grid_first_overlap(&pk->grid, pk->disks, x, y, R, skip_a, skip_b)) == GP_GRID_NONE &&
+             (q = gp_grid_first_overlap(&pk->grid, x, y, R, skip_a, skip_b)) == GP_GRID_NONE &&
              front_barrier_crossed(&pk->fr, x, y, R, skip_segment) == FRONT_NONE;
     if (blocker)
         *blocker = q;
@@ -168,8 +168,13 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
 static void mark_failed(packer *pk, int32_t u, double R)
 {
     double limit = R;
+    const front_node *n = &pk->fr.nodes[u];
+    /* the limit is never below the smaller of R and R_min: a segment that already failed
+     * at or below that keeps its record whatever the limit, so it is not computed (the
+     * first segment of the front's level is tried on every pass, dead pocket or not) */
+    if (n->state == SEG_FAILED && !(fmin(R, pk->R_min) < n->fail_R))
+        return;
     if (pk->blocked >= 0) {
-        const front_node *n = &pk->fr.nodes[u];
         const gp_disk *a = &pk->disks[n->disk];
         gp_disk b_image, q_image;
         limit = pack_fit_limit(a, pack_image(pk, &pk->disks[pk->fr.nodes[n->next].disk], a->x, a->y, &b_image),
@@ -221,7 +226,7 @@ static long gather_conflicts(packer *pk, double x, double y, int32_t u)
 {
     size_t n;
     for (;;) {
-        n = gp_grid_overlaps(&pk->grid, pk->disks, x, y, pk->pending_R, seg_from(pk, u),
+        n = gp_grid_overlaps(&pk->grid, x, y, pk->pending_R, seg_from(pk, u),
                              seg_to(pk, u), pk->conflicts, pk->conflict_capacity);
         if (n + 2 <= pk->conflict_capacity)
             break;
@@ -528,7 +533,8 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
     else if (rc)
         gp_error_set(err, rc, NULL, "out of memory for the bucket grid");
     if (rc == 0) {
-        pk.disks = malloc(capacity * sizeof *pk.disks);
+        /* on a cache line: a disk (32 bytes) then never straddles two */
+        pk.disks = grow_aligned(NULL, 0, capacity, sizeof *pk.disks);
         pk.level = malloc(capacity * sizeof *pk.level);
         pk.closings = malloc(capacity * sizeof *pk.closings);
         pk.capacity = capacity;
