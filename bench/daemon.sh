@@ -15,3 +15,26 @@ while [ ! -s "$dir/port" ]; do sleep 0.05; done
 base="http://127.0.0.1:$(cat "$dir/port")"
 load_start=$(cut -d' ' -f1 /proc/loadavg)
 rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
+
+# concurrent_downloads N URL LABEL FORMAT... - N downloads of URL?f=FORMAT at once (the
+# formats in turn, every second one gzip) and one line: their time and the daemon's memory.
+concurrent_downloads() {
+  local n=$1 url=$2 label=$3
+  shift 3
+  local formats=("$@") idle start end peak enc k
+  idle=$(rss VmRSS)
+  echo 5 > "/proc/$pid/clear_refs"  # VmHWM counts from here
+  start=$(date +%s.%N)
+  for k in $(seq 0 $((n - 1))); do
+    enc=identity
+    [ $((k % 2)) -eq 1 ] && enc=gzip
+    curl -s -o /dev/null -H "Accept-Encoding: $enc" "$url?f=${formats[$((k % ${#formats[@]}))]}" &
+  done
+  wait $(jobs -p | grep -v "^$pid$") 2> /dev/null || true
+  end=$(date +%s.%N)
+  peak=$(rss VmHWM)
+  echo
+  python3 -c "print(f'{$n} concurrent downloads ($label, half gzip): {$end - $start:.1f} s;'
+                    f' daemon RSS before {$idle / 1024:.1f} MB, peak {$peak / 1024:.1f} MB'
+                    f' (+{($peak - $idle) / 1024:.1f} MB), after {$(rss VmRSS) / 1024:.1f} MB')"
+}

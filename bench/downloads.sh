@@ -52,24 +52,7 @@ print(f'| {\"$fmt\"} | {b / 1e6:.1f} MB | {1e3 * $ttfb:.1f} ms | {$total:.3f} s 
       f' {gb / 1e6:.1f} MB ({gb / b:.3f}) | {1e3 * $gz_ttfb:.1f} ms | {$gz_total:.3f} s |')"
 done
 
-if [ "$concurrent" -gt 0 ]; then
-  idle=$(rss VmRSS)
-  echo 5 > "/proc/$pid/clear_refs"  # VmHWM counts from here
-  formats=(csv json svg vtk)
-  start=$(date +%s.%N)
-  for k in $(seq 0 $((concurrent - 1))); do
-    enc=identity
-    [ $((k % 2)) -eq 1 ] && enc=gzip
-    curl -s -o /dev/null -H "Accept-Encoding: $enc" "$base$job/results?f=${formats[$((k % 4))]}" &
-  done
-  wait $(jobs -p | grep -v "^$pid$") 2> /dev/null || true
-  end=$(date +%s.%N)
-  peak=$(rss VmHWM)
-  echo
-  python3 -c "print(f'{$concurrent} concurrent downloads (every format, half gzip): {$end - $start:.1f} s;'
-                    f' daemon RSS idle {$idle / 1024:.1f} MB, peak {$peak / 1024:.1f} MB'
-                    f' (+{($peak - $idle) / 1024:.1f} MB)')"
-fi
+if [ "$concurrent" -gt 0 ]; then concurrent_downloads "$concurrent" "$base$job/results" "every format" csv json svg vtk; fi
 runs_after=$(curl -s "$base/metrics" | awk '$1 == "grainpack_pipeline_runs_total" {print $2}')
 echo
 python3 -c "print(f'job: {$grains} grains, {$t1 - $t0:.1f} s from submission to successful;'

@@ -39,24 +39,7 @@ for fmt in msh inp vtu; do
                     f' {$peak / 1024:.1f} MB | {$after / 1024:.1f} MB | +{($peak - $before) / 1024:.1f} MB |')"
 done
 
-if [ "$concurrent" -gt 0 ]; then
-  idle=$(rss VmRSS)
-  echo 5 > "/proc/$pid/clear_refs"
-  formats=(msh inp vtu)
-  start=$(date +%s.%N)
-  for k in $(seq 0 $((concurrent - 1))); do
-    enc=identity
-    [ $((k % 2)) -eq 1 ] && enc=gzip
-    curl -s -o /dev/null -H "Accept-Encoding: $enc" "$base$job/results?f=${formats[$((k % 3))]}" &
-  done
-  wait $(jobs -p | grep -v "^$pid$") 2> /dev/null || true
-  end=$(date +%s.%N)
-  peak=$(rss VmHWM)
-  echo
-  python3 -c "print(f'{$concurrent} concurrent downloads (msh, inp, vtu in turn, half gzip): {$end - $start:.1f} s;'
-                    f' daemon RSS before {$idle / 1024:.1f} MB, peak {$peak / 1024:.1f} MB'
-                    f' (+{($peak - $idle) / 1024:.1f} MB), after {$(rss VmRSS) / 1024:.1f} MB')"
-fi
+if [ "$concurrent" -gt 0 ]; then concurrent_downloads "$concurrent" "$base$job/results" "msh, inp, vtu in turn" msh inp vtu; fi
 echo
 echo "job: $nodes nodes, $tri triangles, $quad quadrilaterals; daemon $GP_DAEMON"
 echo "load average $load_start at the start, $(cut -d' ' -f1 /proc/loadavg) at the end;" \

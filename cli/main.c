@@ -40,7 +40,7 @@ static void usage(FILE *out)
           "                       inp (Abaqus); msh and inp need \"mesh\" in the spec\n"
           "                       pack3d: json (default), csv (x,y,z,r,R), vtu (VTK XML:\n"
           "                       the polyhedra, else the sphere centres), tess (Neper's\n"
-          "                       tessellation; needs \"cells\" in the spec), svg (the\n"
+          "                       tessellation; needs \"laguerre\" in the spec), svg (the\n"
           "                       section of \"picture\": {\"section\": {\"axis\", \"at\"}})\n"
           "  -o FILE              write to FILE instead of standard output\n"
           "  --max-disks N        refuse specs expected to need more than N disks (or\n"

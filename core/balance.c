@@ -569,15 +569,11 @@ static int run_sweeps(balancer *b, const gp_balance_params *params, const gp_pro
             (rc = balance_report(progress, share * out->sweeps, err)))
             return rc;
         nearby_sort(&b->near, b->disks);
-        int better, stop = balance_watch_sweep(&watch, b->method, out->sweeps, &now, &better);
-        if (better) {
-            out->best_sweep = out->sweeps;
+        int better, stop = balance_watch_record(&watch, b->method, out, &now, &better);
+        if (better)
             save_best(b);
-        }
-        if (stop >= 0) {
-            out->stop = (gp_balance_stop)stop;
+        if (stop)
             break;
-        }
     }
     restore_best(b);
     if (b->domain->periodic) {

@@ -321,15 +321,11 @@ static int run_sweeps(balancer3 *b, const gp_balance_params *params, const gp_pr
         if ((rc = follow(b, 0, progress, &now, out, err)) ||
             (rc = balance_report(progress, share * out->sweeps, err)))
             return rc;
-        int better, stop = balance_watch_sweep(&watch, b->method, out->sweeps, &now, &better);
-        if (better) {
-            out->best_sweep = out->sweeps;
+        int better, stop = balance_watch_record(&watch, b->method, out, &now, &better);
+        if (better)
             save_best(b);
-        }
-        if (stop >= 0) {
-            out->stop = (gp_balance_stop)stop;
+        if (stop)
             break;
-        }
     }
     /* the best is the last structure measured (the triangulation's), or is built again */
     if (restore_best(b))

@@ -93,4 +93,17 @@ static inline int balance_report(const gp_progress *progress, double fraction, g
     return 0;
 }
 
+/* balance_watch_sweep for the sweep `out` just counted: records in `out` the best sweep
+ * (when *better) and the stop called for; returns whether the sweeps end here. */
+static inline int balance_watch_record(balance_watch *w, gp_balance_method method, gp_balance_result *out,
+                                       const gp_quality_stats *now, int *better)
+{
+    int stop = balance_watch_sweep(w, method, out->sweeps, now, better);
+    if (*better)
+        out->best_sweep = out->sweeps;
+    if (stop >= 0)
+        out->stop = (gp_balance_stop)stop;
+    return stop >= 0;
+}
+
 #endif
