@@ -50,7 +50,7 @@ int gp_grid_init(gp_grid *grid, const gp_domain *domain, double R_max, size_t ca
 void gp_grid_free(gp_grid *grid)
 {
     free(grid->head);
-    free(grid->entry);
+    free(grid->next);
     memset(grid, 0, sizeof *grid);
 }
 
@@ -58,18 +58,18 @@ int gp_grid_reserve(gp_grid *grid, size_t capacity)
 {
     if (capacity <= grid->capacity)
         return 0;
-    gp_grid_entry *entry = grow_aligned(grid->entry, grid->capacity, capacity, sizeof *entry);
-    if (!entry)
+    int32_t *next = grow_realloc(grid->next, capacity, sizeof *next);
+    if (!next)
         return GP_ENOMEM;
-    grid->entry = entry;
+    grid->next = next;
     grid->capacity = capacity;
     return 0;
 }
 
-void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y, double R)
+void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y)
 {
     size_t c = gp_grid_cell(grid, x, y);
-    grid->entry[id] = (gp_grid_entry){x, y, R, grid->head[c], 0};
+    grid->next[id] = grid->head[c];
     grid->head[c] = id;
 }
 
@@ -77,22 +77,22 @@ void gp_grid_remove(gp_grid *grid, int32_t id, double x, double y)
 {
     int32_t *link = &grid->head[gp_grid_cell(grid, x, y)];
     while (*link != GP_GRID_NONE && *link != id)
-        link = &grid->entry[*link].next;
+        link = &grid->next[*link];
     if (*link == id)
-        *link = grid->entry[id].next;
+        *link = grid->next[id];
 }
 
 /* Tests the disks of one cell's list from `id` on against the candidate (x, y, R), with
  * minimum-image distances when `periodic`: stores each overlapping one other than the
  * skipped two in out (if room) and counts it in *found. Returns 1 to stop (the first one
  * found when `first_only`). Inline, with `periodic` a constant at each call. */
-static inline int scan_list(const gp_grid *grid, int32_t id, double x,
+static inline int scan_list(const gp_grid *grid, const gp_disk *disks, int32_t id, double x,
                             double y, double R, int32_t skip_a, int32_t skip_b, int first_only,
                             int periodic, int32_t *out, size_t cap, size_t *found)
 {
     double shrink = 1.0 - GP_CONTACT_RTOL;
-    for (; id != GP_GRID_NONE; id = grid->entry[id].next) {
-        const gp_grid_entry *d = &grid->entry[id];
+    for (; id != GP_GRID_NONE; id = grid->next[id]) {
+        const gp_disk *d = &disks[id];
         double dx = d->x - x, dy = d->y - y;
         if (periodic)
             gp_domain_min_image(grid->domain, &dx, &dy);
@@ -113,7 +113,7 @@ static inline int scan_list(const gp_grid *grid, int32_t id, double x,
  * skipped two, stores it (if room) and stops after the first when `first_only`. On a
  * periodic domain the cells wrap across the periodic sides and distances are between
  * nearest images. */
-static size_t scan_overlaps(const gp_grid *grid, double x, double y,
+static size_t scan_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
                             double R, int32_t skip_a, int32_t skip_b, int first_only,
                             int32_t *out, size_t cap)
 {
@@ -121,7 +121,7 @@ static size_t scan_overlaps(const gp_grid *grid, double x, double y,
     if (!grid->domain->periodic) {
         const int32_t *center = grid->head + gp_grid_cell(grid, x, y);
         for (int k = 0; k < 9; k++)
-            if (scan_list(grid, center[grid->around[k]], x, y, R, skip_a, skip_b, first_only,
+            if (scan_list(grid, disks, center[grid->around[k]], x, y, R, skip_a, skip_b, first_only,
                           0, out, cap, &found))
                 break;
         return found;
@@ -130,24 +130,24 @@ static size_t scan_overlaps(const gp_grid *grid, double x, double y,
     gp_grid_coords(grid, x, y, &ix, &iy);
     for (int k = 0; k < 9; k++) {
         size_t c = gp_grid_index_wrapped(grid, ix + order[k][0], iy + order[k][1]);
-        if (scan_list(grid, grid->head[c], x, y, R, skip_a, skip_b, first_only, 1, out,
+        if (scan_list(grid, disks, grid->head[c], x, y, R, skip_a, skip_b, first_only, 1, out,
                       cap, &found))
             break;
     }
     return found;
 }
 
-int32_t gp_grid_first_overlap(const gp_grid *grid, double x, double y, double R, int32_t skip_a,
-                              int32_t skip_b)
+int32_t gp_grid_first_overlap(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                              double R, int32_t skip_a, int32_t skip_b)
 {
     int32_t id = GP_GRID_NONE;
-    scan_overlaps(grid, x, y, R, skip_a, skip_b, 1, &id, 1);
+    scan_overlaps(grid, disks, x, y, R, skip_a, skip_b, 1, &id, 1);
     return id;
 }
 
-size_t gp_grid_overlaps(const gp_grid *grid, double x, double y, double R, int32_t skip_a,
-                        int32_t skip_b, int32_t *out, size_t cap)
+size_t gp_grid_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                        double R, int32_t skip_a, int32_t skip_b, int32_t *out, size_t cap)
 {
-    return scan_overlaps(grid, x, y, R, skip_a, skip_b, 0, out, cap);
+    return scan_overlaps(grid, disks, x, y, R, skip_a, skip_b, 0, out, cap);
 }
 

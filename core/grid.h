@@ -22,20 +22,10 @@ extern "C" {
  * so no image of a disk is counted twice. */
 #define GP_GRID_MIN_PERIOD_CELLS 3
 
-/* What the grid keeps of a disk: its centre and packing radius, copied at insertion, and
- * the next disk of its cell, in one 32-byte record (two to a cache line, the array on a
- * line boundary): a query reads one record per disk instead of the link here and the disk
- * elsewhere, which at 10^6 disks and beyond were two cache misses. */
-typedef struct gp_grid_entry {
-    double x, y, R;
-    int32_t next;      /* the next disk of its cell, GP_GRID_NONE at the end */
-    int32_t unused;    /* pads the record to 32 bytes */
-} gp_grid_entry;
-
-/* Cells are singly linked lists threaded through the entries, indexed by disk. A border of
+/* Cells are singly linked lists threaded through `next`, indexed by disk. A border of
  * always-empty cells surrounds the nx x ny cells over the domain, so that a 3x3 scan
  * never tests bounds: cell (ix, iy), 0 <= ix < nx, has index (iy + 1) * stride + ix + 1.
- * The grid does not own the disks; it owns `head` and `entry`. */
+ * The grid does not own the disks; it owns `head` and `next`. */
 typedef struct gp_grid {
     double cell;       /* side of a cell, >= 2 R_max (along a walled axis: exactly) */
     double inv_cell;
@@ -45,8 +35,8 @@ typedef struct gp_grid {
     size_t ncells;     /* (nx + 2) * (ny + 2), border included */
     int32_t around[9]; /* index offsets of a cell and its neighbours, in the report's order */
     int32_t *head;     /* ncells first disks, GP_GRID_NONE when empty */
-    gp_grid_entry *entry; /* per disk, on a cache line (grow_aligned) */
-    size_t capacity;   /* entries allocated */
+    int32_t *next;     /* per disk: the next disk of its cell */
+    size_t capacity;   /* entries allocated in next */
     const gp_domain *domain; /* borrowed: the domain the candidates must stay in */
 } gp_grid;
 
@@ -62,23 +52,22 @@ void gp_grid_free(gp_grid *grid);
 /* Makes room for disks with ids below `capacity`; returns 0 or GP_ENOMEM. */
 int gp_grid_reserve(gp_grid *grid, size_t capacity);
 
-/* Inserts disk `id` centred at (x, y) with packing radius R (room must have been
- * reserved); the queries below test it at that place and radius. */
-void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y, double R);
+/* Inserts disk `id` centred at (x, y) (room must have been reserved). */
+void gp_grid_insert(gp_grid *grid, int32_t id, double x, double y);
 
 /* Removes disk `id`, which was inserted with centre (x, y). */
 void gp_grid_remove(gp_grid *grid, int32_t id, double x, double y);
 
-/* The first disk inserted overlapping the candidate packing disk (x, y, R), skipping
+/* The first disk of `disks` overlapping the candidate packing disk (x, y, R), skipping
  * ids skip_a and skip_b, searched in the report's order (own cell, the four edge
  * neighbours, the four corners); GP_GRID_NONE if there is none. Does not test the domain. */
-int32_t gp_grid_first_overlap(const gp_grid *grid, double x, double y, double R, int32_t skip_a,
-                              int32_t skip_b);
+int32_t gp_grid_first_overlap(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                              double R, int32_t skip_a, int32_t skip_b);
 
 /* All disks overlapping the candidate, as above; writes at most `cap` ids to `out` and
  * returns how many overlap. */
-size_t gp_grid_overlaps(const gp_grid *grid, double x, double y, double R, int32_t skip_a,
-                        int32_t skip_b, int32_t *out, size_t cap);
+size_t gp_grid_overlaps(const gp_grid *grid, const gp_disk *disks, double x, double y,
+                        double R, int32_t skip_a, int32_t skip_b, int32_t *out, size_t cap);
 
 /* The cell (ix, iy) holding point (x, y), 0 <= ix < nx, 0 <= iy < ny; points outside the
  * domain go to the nearest cell along a walled axis, to their image's cell along a periodic

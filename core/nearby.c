@@ -99,7 +99,7 @@ void nearby_move(nearby *nb, const gp_disk *disks, int32_t id, double old_x, dou
         gp_grid_remove(&nb->grid, id, old_x, old_y);
     else
         e->x = INFINITY; /* out of reach of every box: never gathered again */
-    gp_grid_insert(&nb->grid, id, disks[id].x, disks[id].y, disks[id].R);
+    gp_grid_insert(&nb->grid, id, disks[id].x, disks[id].y);
 }
 
 /* reserve when the room is not there. */
@@ -171,7 +171,7 @@ int nearby_gather(nearby *nb, const gp_disk *disks, int32_t id, double R, double
         for (const nearby_entry *e = nb->sorted + lo; e < nb->sorted + hi; e++)
             keep_if(nb, e->x, e->y, e->R, near_box(nb, e->x, e->y, e->R, R) & (e->id != id));
         for (size_t c = first; c <= last; c++)
-            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->entry[j].next) {
+            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->next[j]) {
                 if (reserve(nb, nb->gn + 1))
                     return GP_ENOMEM;
                 keep_if(nb, disks[j].x, disks[j].y, disks[j].R, near_box(nb, disks[j].x, disks[j].y, disks[j].R, R) & (j != id));
@@ -244,7 +244,7 @@ int nearby_is_clear(nearby *nb, const gp_disk *disks, int32_t id, double R, doub
             if (e->id != id && overlaps(e->x - x, e->y - y, e->R, R))
                 return 0;
         for (size_t c = first; c <= last; c++)
-            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->entry[j].next)
+            for (int32_t j = g->head[c]; j != GP_GRID_NONE; j = g->next[j])
                 if (j != id && overlaps(disks[j].x - x, disks[j].y - y, disks[j].R, R))
                     return 0;
     }

@@ -67,7 +67,7 @@ int32_t pack_add_disk(packer *pk, double x, double y, uint32_t level)
     pk->disks[id] = (gp_disk){x, y, pk->pending_r, pk->pending_R};
     pk->level[id] = level;
     pk->closings[id] = 0;
-    gp_grid_insert(&pk->grid, id, x, y, pk->pending_R);
+    gp_grid_insert(&pk->grid, id, x, y);
     front_disk_added(&pk->fr, id);
     pk->out->fill_area += M_PI * pk->pending_R * pk->pending_R;
     if (level > pk->out->max_level)
@@ -81,7 +81,7 @@ int pack_fits(const packer *pk, double x, double y, double R, int32_t skip_a, in
 {
     int32_t q = GP_GRID_NONE;
     int ok = gp_domain_contains_disk(pk->params->domain, x, y, R, R * GP_CONTACT_RTOL) &&
-             (q = gp_grid_first_overlap(&pk->grid, x, y, R, skip_a, skip_b)) == GP_GRID_NONE &&
+             (q = gp_grid_first_overlap(&pk->grid, pk->disks, x, y, R, skip_a, skip_b)) == GP_GRID_NONE &&
              front_barrier_crossed(&pk->fr, x, y, R, skip_segment) == FRONT_NONE;
     if (blocker)
         *blocker = q;
@@ -226,7 +226,7 @@ static long gather_conflicts(packer *pk, double x, double y, int32_t u)
 {
     size_t n;
     for (;;) {
-        n = gp_grid_overlaps(&pk->grid, x, y, pk->pending_R, seg_from(pk, u),
+        n = gp_grid_overlaps(&pk->grid, pk->disks, x, y, pk->pending_R, seg_from(pk, u),
                              seg_to(pk, u), pk->conflicts, pk->conflict_capacity);
         if (n + 2 <= pk->conflict_capacity)
             break;

@@ -81,7 +81,7 @@ static int lay_chain(packer *pk, const chain_wall *w)
             int rc = pack_work(pk, pk->query_units);
             if (rc)
                 return rc;
-            int32_t q = gp_grid_first_overlap(&pk->grid, cx, cy, R, -1, -1);
+            int32_t q = gp_grid_first_overlap(&pk->grid, pk->disks, cx, cy, R, -1, -1);
             if (q == GP_GRID_NONE)
                 break;
             if (q >= first)

@@ -143,7 +143,7 @@ static int walk_wall(packer *pk, const walls *w, int i, int32_t corner, id_list 
             int rc = pack_work(pk, pk->query_units);
             if (rc)
                 return rc;
-            int32_t q = gp_grid_first_overlap(&pk->grid, cx, cy, R, -1, -1);
+            int32_t q = gp_grid_first_overlap(&pk->grid, pk->disks, cx, cy, R, -1, -1);
             if (q == GP_GRID_NONE)
                 break;
             const gp_disk *dq = &pk->disks[q];

@@ -30,7 +30,7 @@ static void setup(fixture *fx, int n)
     for (int i = 0; i < n; i++) {
         double t = 2 * M_PI * i / n;
         fx->disks[i] = (gp_disk){20 + 10 * cos(t), 20 + 10 * sin(t), 1, 1};
-        gp_grid_insert(&fx->grid, i, fx->disks[i].x, fx->disks[i].y, fx->disks[i].R);
+        gp_grid_insert(&fx->grid, i, fx->disks[i].x, fx->disks[i].y);
         ids[i] = i;
     }
     CHECK(front_add_loop(&fx->f, ids, (size_t)n) == 0);

@@ -108,7 +108,7 @@ static void test_grid_finds_exactly_the_overlaps_brute_force_finds(void)
     for (int i = 0; i < N; i++) {
         disks[i] = (gp_disk){20 * gp_rng_uniform(&rng), 10 * gp_rng_uniform(&rng), 0,
                              0.05 + 0.45 * gp_rng_uniform(&rng)};
-        gp_grid_insert(&grid, i, disks[i].x, disks[i].y, disks[i].R);
+        gp_grid_insert(&grid, i, disks[i].x, disks[i].y);
     }
     /* remove a few, to exercise removal */
     for (int i = 0; i < N; i += 7)
@@ -118,7 +118,7 @@ static void test_grid_finds_exactly_the_overlaps_brute_force_finds(void)
     for (int t = 0; t < 500; t++) {
         double x = 20 * gp_rng_uniform(&rng), y = 10 * gp_rng_uniform(&rng);
         double R = 0.05 + 0.45 * gp_rng_uniform(&rng);
-        size_t n = gp_grid_overlaps(&grid, x, y, R, 1, 2, found, N);
+        size_t n = gp_grid_overlaps(&grid, disks, x, y, R, 1, 2, found, N);
         size_t expected = 0;
         for (int i = 0; i < N; i++) {
             if (i % 7 == 0 || i == 1 || i == 2)
@@ -127,7 +127,7 @@ static void test_grid_finds_exactly_the_overlaps_brute_force_finds(void)
             expected += gp_disks_overlap(&c, &disks[i]);
         }
         mismatches += n != expected;
-        int32_t first = gp_grid_first_overlap(&grid, x, y, R, 1, 2);
+        int32_t first = gp_grid_first_overlap(&grid, disks, x, y, R, 1, 2);
         mismatches += (first == GP_GRID_NONE) != (expected == 0);
     }
     CHECK_MSG(mismatches == 0, "%d queries disagree with brute force", mismatches);
