@@ -1,7 +1,11 @@
 /* pack3d_bench.c - the 3D packer's figures (bench/PACK3D.md): density and time of the
  * three reference laws in boxes of 20 largest diameters under both orders of the front,
- * and the rate and memory at 10^5 and 10^6 spheres of one radius.
- * Usage: grainpack_pack3d_bench [--seeds N] [--max-spheres N] [EXAMPLES_DIR] */
+ * and the rate and memory at 10^5 and 10^6 spheres of one radius. --fingerprint prints
+ * instead a hash of the reference packings' spheres (a pure speed change must leave them
+ * to the bit), --case LAW packs one small box of a law alone (for callgrind's instruction
+ * counts: one, bagi or iron).
+ * Usage: grainpack_pack3d_bench [--seeds N] [--max-spheres N] [--fingerprint] [--case LAW]
+ *        [EXAMPLES_DIR] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -108,14 +112,46 @@ static void scaling_row(const gp_distribution *dist, double target)
     _exit(0);
 }
 
+/* FNV-1a over the bytes of the spheres (centres and radii as stored, so to the bit). */
+static unsigned long long spheres_hash(const gp_packing3d *out)
+{
+    const unsigned char *b = (const unsigned char *)out->spheres;
+    unsigned long long h = 1469598103934665603ULL;
+    for (size_t i = 0; i < out->count * sizeof *out->spheres; i++) {
+        h ^= b[i];
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* One packing's line: its spheres, density, tries and hash. */
+static void fingerprint_row(const char *name, const gp_distribution *dist, double side, uint64_t seed,
+                            gp_pack3d_order order)
+{
+    gp_box box = {side, side, side};
+    gp_packing3d out;
+    double cpu;
+    pack_once(&box, dist, seed, order, &out, &cpu);
+    printf("%s side %g seed %llu order %d: %zu spheres density %.6f attempts %llu triangles %llu hash %016llx\n",
+           name, side, (unsigned long long)seed, (int)order, out.count, out.fill_volume / (side * side * side),
+           (unsigned long long)out.attempts, (unsigned long long)out.triangles, spheres_hash(&out));
+    fflush(stdout);
+    gp_packing3d_free(&out);
+}
+
 int main(int argc, char **argv)
 {
     int seeds = 5;
     double max_spheres = 1e6;
-    const char *examples = "examples";
+    const char *examples = "examples", *one_case = NULL;
+    int fingerprint = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--seeds") && i + 1 < argc)
             seeds = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--fingerprint"))
+            fingerprint = 1;
+        else if (!strcmp(argv[i], "--case") && i + 1 < argc)
+            one_case = argv[++i];
         else if (!strcmp(argv[i], "--max-spheres") && i + 1 < argc)
             max_spheres = atof(argv[++i]);
         else
@@ -130,6 +166,37 @@ int main(int argc, char **argv)
     gp_error err;
     if (gp_spec_load_file(path, NULL, &iron, &err))
         bench_die(path, &err);
+
+    /* the boxes of the instruction counts (bench/PACK3D.md): 16 diameters, 12 largest ones
+     * for the Bagi law and 10 for iron, a few thousand spheres each */
+    if (one_case) {
+        if (!strcmp(one_case, "one"))
+            fingerprint_row("one radius 0.5", &one, 16.0, 1, GP_PACK3D_LEVEL);
+        else if (!strcmp(one_case, "bagi"))
+            fingerprint_row("3D Bagi", &bagi, 12 * 0.84, 1, GP_PACK3D_LEVEL);
+        else if (!strcmp(one_case, "iron"))
+            fingerprint_row("iron", &iron.dist, 10 * 16.0, 1, GP_PACK3D_LEVEL);
+        else {
+            fprintf(stderr, "unknown case %s (one, bagi or iron)\n", one_case);
+            return 2;
+        }
+        gp_spec_free(&iron);
+        return 0;
+    }
+    if (fingerprint) {
+        for (int o = 0; o < 2; o++) {
+            fingerprint_row("one radius 0.5", &one, 20.0, 1, (gp_pack3d_order)o);
+            for (int s = 1; s <= 3; s++)
+                fingerprint_row("3D Bagi", &bagi, 20 * 0.84, (uint64_t)s, (gp_pack3d_order)o);
+            for (int s = 1; s <= 2; s++)
+                fingerprint_row("iron", &iron.dist, 20 * 16.0, (uint64_t)s, (gp_pack3d_order)o);
+        }
+        if (max_spheres >= 1e6)
+            fingerprint_row("one radius 0.5, 10^6", &one, cbrt(1e6 * (4.0 / 3.0 * M_PI * 0.125) / 0.62), 1,
+                            GP_PACK3D_LEVEL);
+        gp_spec_free(&iron);
+        return 0;
+    }
 
     printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS growth) |\n");
     printf("|---|---|---|---|---|---|---|---|---|\n");

@@ -61,6 +61,12 @@ uint32_t p3_key(const p3_packer *pk, const int32_t m[3])
     return key;
 }
 
+/* The smaller of two numbers, neither NaN (libm's fmin is a call). */
+static inline double min2(double a, double b)
+{
+    return b < a ? b : a;
+}
+
 /* Of two positions that both fit, the one taken (docs/3d.md §3): under the level rule the
  * one nearer a wall, so that the front fills behind itself before it moves inward; in a
  * deposition the lower. Returns 1 when b is preferred to a. */
@@ -71,8 +77,8 @@ static int prefer(const p3_packer *pk, const double a[3], const double b[3])
     const double side[3] = {pk->box->width, pk->box->height, pk->box->depth};
     double da = INFINITY, db = INFINITY;
     for (int k = 0; k < 3; k++) {
-        da = fmin(da, fmin(a[k], side[k] - a[k]));
-        db = fmin(db, fmin(b[k], side[k] - b[k]));
+        da = min2(da, min2(a[k], side[k] - a[k]));
+        db = min2(db, min2(b[k], side[k] - b[k]));
     }
     return db < da;
 }

@@ -48,6 +48,11 @@ static inline int32_t p3_grid_cell(const p3_grid *grid, int32_t i, int32_t j, in
 {
     return grid->head[((size_t)k * (size_t)grid->n[1] + (size_t)j) * (size_t)grid->n[0] + (size_t)i];
 }
+/* The heads of the cells (0..n[0]-1, j, k). */
+static inline const int32_t *p3_grid_row(const p3_grid *grid, int32_t j, int32_t k)
+{
+    return grid->head + ((size_t)k * (size_t)grid->n[1] + (size_t)j) * (size_t)grid->n[0];
+}
 void p3_grid_free(p3_grid *grid);
 /* The index range of the cells a ball of radius `reach` around (x, y, z) meets. */
 void p3_grid_range(const p3_grid *grid, double x, double y, double z, double reach, int32_t lo[3],
