@@ -45,6 +45,7 @@ void front_free(front *f)
 {
     free(f->buckets);
     free(f->nodes);
+    free(f->cold);
     free(f->first_node);
     free(f->barrier_head);
     free(f->links);
@@ -317,12 +318,13 @@ static int register_barrier(front *f, int32_t u)
 {
     double part[4];
     front_node *n = &f->nodes[u];
-    n->barrier_cell = FRONT_NONE;
+    front_cold *c = &f->cold[u];
+    c->barrier_cell = FRONT_NONE;
     if (!uncovered_part(f, u, &part[0], &part[1], &part[2], &part[3]) ||
         !gap_crossable(&(*f->disks)[n->disk], &(*f->disks)[f->nodes[n->next].disk], n->length,
                        f->class_lo))
         return 0;
-    memcpy(n->gap, part, sizeof part);
+    memcpy(c->gap, part, sizeof part);
     int32_t range[4];
     barrier_cells(f, part, range);
     for (int32_t cy = range[1]; cy <= range[3]; cy++) {
@@ -342,17 +344,17 @@ static int register_barrier(front *f, int32_t u)
             f->barrier_head[cell] = link;
         }
     }
-    n->barrier_cell = 1;
+    c->barrier_cell = 1;
     return 0;
 }
 
 static void unregister_barrier(front *f, int32_t u)
 {
-    front_node *n = &f->nodes[u];
-    if (n->barrier_cell == FRONT_NONE)
+    front_cold *c = &f->cold[u];
+    if (c->barrier_cell == FRONT_NONE)
         return;
     int32_t range[4];
-    barrier_cells(f, n->gap, range);
+    barrier_cells(f, c->gap, range);
     for (int32_t cy = range[1]; cy <= range[3]; cy++) {
         for (int32_t cx = range[0]; cx <= range[2]; cx++) {
             int32_t *link = &f->barrier_head[gp_grid_index_wrapped(f->grid, cx, cy)];
@@ -364,7 +366,7 @@ static void unregister_barrier(front *f, int32_t u)
             f->free_link = gone;
         }
     }
-    n->barrier_cell = FRONT_NONE;
+    c->barrier_cell = FRONT_NONE;
 }
 
 /* Squared distance from (x, y) to the segment [p, q]. */
@@ -384,7 +386,7 @@ int32_t front_barrier_crossed(const front *f, double x, double y, double R, int3
     for (int32_t link = f->barrier_head[gp_grid_cell(f->grid, x, y)]; link != FRONT_NONE;
          link = f->links[link].next) {
         int32_t u = f->links[link].node;
-        const double *part = f->nodes[u].gap;
+        const double *part = f->cold[u].gap;
         double px = x, py = y;
         if (f->grid->domain->periodic) {
             /* the candidate's image nearest the part's start */
@@ -418,7 +420,7 @@ static int attach_segment(front *f, int32_t u, int touching)
     if (bucket_push(f, u))
         return GP_ENOMEM;
     f->active++;
-    n->barrier_cell = FRONT_NONE;
+    f->cold[u].barrier_cell = FRONT_NONE;
     return touching ? 0 : register_barrier(f, u);
 }
 
@@ -444,6 +446,27 @@ void front_freeze(front *f, int32_t u)
 
 /* ---- nodes ---- */
 
+/* Doubles the room for nodes (grow_capacity): the hot parts in a fresh block on a cache
+ * line (grow_aligned), the cold ones reallocated. Returns 0 or GP_ENOMEM (the front then
+ * untouched). */
+static int grow_nodes(front *f)
+{
+    _Static_assert(sizeof(front_node) == GROW_CACHE_LINE, "a node's hot part is one cache line");
+    size_t cap = grow_capacity(f->node_capacity, f->nnodes + 1);
+    if (!cap || cap > INT32_MAX)
+        return GP_ENOMEM;
+    front_cold *cold = grow_realloc(f->cold, cap, sizeof *cold);
+    if (!cold)
+        return GP_ENOMEM;
+    f->cold = cold;
+    front_node *nodes = grow_aligned(f->nodes, f->nnodes, cap, sizeof *nodes);
+    if (!nodes)
+        return GP_ENOMEM; /* the cold parts' extra room is harmless */
+    f->nodes = nodes;
+    f->node_capacity = cap;
+    return 0;
+}
+
 static int32_t new_node(front *f, int32_t disk, uint32_t loop)
 {
     int32_t u;
@@ -451,18 +474,18 @@ static int32_t new_node(front *f, int32_t disk, uint32_t loop)
         u = f->free_node;
         f->free_node = f->nodes[u].next;
     } else {
-        front_node *nodes = grow(f->nodes, &f->node_capacity, f->nnodes + 1, sizeof *nodes);
-        if (!nodes)
+        if (f->nnodes == f->node_capacity && grow_nodes(f))
             return GP_ENOMEM;
-        f->nodes = nodes;
         u = (int32_t)f->nnodes++;
     }
     front_node *n = &f->nodes[u];
     memset(n, 0, sizeof *n);
     n->disk = disk;
-    n->loop = loop;
-    n->barrier_cell = FRONT_NONE;
-    n->next_of_disk = f->first_node[disk];
+    front_cold *c = &f->cold[u];
+    memset(c, 0, sizeof *c);
+    c->loop = loop;
+    c->barrier_cell = FRONT_NONE;
+    c->next_of_disk = f->first_node[disk];
     f->first_node[disk] = u;
     return u;
 }
@@ -472,8 +495,8 @@ static void free_node(front *f, int32_t u)
 {
     int32_t *link = &f->first_node[f->nodes[u].disk];
     while (*link != u)
-        link = &f->nodes[*link].next_of_disk;
-    *link = f->nodes[u].next_of_disk;
+        link = &f->cold[*link].next_of_disk;
+    *link = f->cold[u].next_of_disk;
     f->nodes[u].next = f->free_node;
     f->free_node = u;
 }
@@ -525,7 +548,7 @@ static void label_loop(front *f, int32_t start, uint32_t loop)
     double sx = 0.0, sy = 0.0;
     int32_t u = start;
     do {
-        f->nodes[u].loop = loop;
+        f->cold[u].loop = loop;
         if (periodic(f)) {
             double dx, dy;
             disk_vector(f, &(*f->disks)[f->nodes[u].disk],
@@ -580,7 +603,7 @@ int front_add_loop(front *f, const int32_t *disks, size_t n)
 int front_place(front *f, int32_t u, int32_t c, int c_touches_b)
 {
     int32_t v = f->nodes[u].next;
-    int32_t w = new_node(f, c, f->nodes[u].loop);
+    int32_t w = new_node(f, c, f->cold[u].loop);
     if (w < 0)
         return w;
     detach_segment(f, u);
@@ -595,19 +618,19 @@ int front_place(front *f, int32_t u, int32_t c, int c_touches_b)
 
 int32_t front_node_on_loop(const front *f, int32_t disk, int32_t u)
 {
-    for (int32_t w = f->first_node[disk]; w != FRONT_NONE; w = f->nodes[w].next_of_disk)
-        if (f->nodes[w].loop == f->nodes[u].loop)
+    for (int32_t w = f->first_node[disk]; w != FRONT_NONE; w = f->cold[w].next_of_disk)
+        if (f->cold[w].loop == f->cold[u].loop)
             return w;
     return FRONT_NONE;
 }
 
 int32_t front_node_on_winding_loop(const front *f, int32_t disk, int32_t u)
 {
-    uint32_t loop = f->nodes[u].loop;
+    uint32_t loop = f->cold[u].loop;
     if (!periodic(f) || !winds(f, loop))
         return FRONT_NONE;
-    for (int32_t w = f->first_node[disk]; w != FRONT_NONE; w = f->nodes[w].next_of_disk)
-        if (f->nodes[w].loop != loop && winds(f, f->nodes[w].loop))
+    for (int32_t w = f->first_node[disk]; w != FRONT_NONE; w = f->cold[w].next_of_disk)
+        if (f->cold[w].loop != loop && winds(f, f->cold[w].loop))
             return w;
     return FRONT_NONE;
 }
@@ -617,7 +640,7 @@ int32_t front_node_on_winding_loop(const front *f, int32_t disk, int32_t u)
  * label, and its winding is what the shorter's leaves of the old loop's. */
 static int relabel_shorter(front *f, int32_t a, int32_t b)
 {
-    uint32_t old = f->nodes[a].loop;
+    uint32_t old = f->cold[a].loop;
     int32_t x = f->nodes[a].next, y = f->nodes[b].next;
     while (x != a && y != b) {
         x = f->nodes[x].next;
@@ -654,13 +677,13 @@ static int cut_ear(front *f, int32_t before, int32_t middle)
 int front_close(front *f, int32_t u, int32_t w)
 {
     int32_t v = f->nodes[u].next;
-    int merge = f->nodes[w].loop != f->nodes[u].loop;
+    int merge = f->cold[w].loop != f->cold[u].loop;
     if (w == f->nodes[v].next)
         return cut_ear(f, u, v); /* pk follows p2: p2 leaves the loop */
     if (w == f->nodes[u].prev)
         return cut_ear(f, w, u); /* pk precedes p1: p1 leaves the loop */
     /* pk elsewhere on the loop: p1 -> pk -> (on to p1) and pk' -> p2 -> (on to pk') */
-    int32_t w2 = new_node(f, f->nodes[w].disk, f->nodes[u].loop);
+    int32_t w2 = new_node(f, f->nodes[w].disk, f->cold[u].loop);
     if (w2 < 0)
         return w2;
     int32_t before_w = f->nodes[w].prev;

@@ -30,22 +30,32 @@
 
 #define FRONT_NONE (-1)
 
+/* A node's hot part: what the packer's loop reads for every segment it tries (its
+ * geometry, its failure record, its links), in one 64-byte cache line (nodes are
+ * allocated on a line boundary). The parts a try does not read are in front_cold: at
+ * 10^7 disks the front's nodes are far larger than the cache, and every try of a
+ * segment touching one line rather than two is what keeps the time per disk flat. */
 typedef struct front_node {
+    double ux, uy, length;  /* the segment disk -> next's disk: unit vector a -> b and
+                               distance of the centres */
+    double fail_R;          /* the segment takes no radius from fail_R up; +inf if untried */
     int32_t disk;
     int32_t prev, next;     /* neighbours on the loop; next is the free list when unused */
-    int32_t next_of_disk;   /* another node of the same disk */
-    uint32_t loop;          /* loop label: equal labels, same loop */
-    /* the segment disk -> next's disk */
-    double ux, uy, length;  /* unit vector a -> b and distance of the centres */
+    int32_t list_prev, list_next; /* neighbours in its list (untried, or failed of a class) */
+    int32_t blocker;        /* SEG_FAILED: the disk last in the way, tested first next time */
     uint32_t level;         /* level(a) + level(b) (report eq. 5) */
     uint8_t state;          /* SEG_UNTRIED, SEG_FAILED or SEG_FROZEN */
     uint8_t fail_class;     /* SEG_FAILED: class of fail_R, the list it is in */
-    double fail_R;          /* the segment takes no radius from fail_R up; +inf if untried */
-    int32_t list_prev, list_next; /* neighbours in its list (untried, or failed of a class) */
-    int32_t blocker;        /* SEG_FAILED: the disk last in the way, tested first next time */
+} front_node;
+
+/* A node's cold part (same index as its front_node): read when loops are labelled,
+ * closed or searched, and for barriers. */
+typedef struct front_cold {
+    int32_t next_of_disk;   /* another node of the same disk */
+    uint32_t loop;          /* loop label: equal labels, same loop */
     int32_t barrier_cell;   /* FRONT_NONE unless the segment is a registered barrier */
     double gap[4];          /* the uncovered part of a barrier: px, py, qx, qy */
-} front_node;
+} front_cold;
 
 enum { SEG_UNTRIED = 0, SEG_FAILED, SEG_FROZEN };
 
@@ -75,7 +85,8 @@ typedef struct front {
     const uint32_t *const *levels;
     const gp_grid *grid;
 
-    front_node *nodes;
+    front_node *nodes;            /* on a cache line (grow_aligned) */
+    front_cold *cold;             /* per node, as nodes */
     size_t nnodes, node_capacity;
     int32_t free_node;
     uint32_t next_loop;

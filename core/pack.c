@@ -37,7 +37,7 @@ static void draw_radius(packer *pk)
 static int grow_disks(packer *pk)
 {
     size_t cap = pk->capacity + pk->capacity / 2 + 64;
-    gp_disk *disks = grow_realloc(pk->disks, cap, sizeof *disks);
+    gp_disk *disks = grow_aligned(pk->disks, pk->count, cap, sizeof *disks);
     if (!disks)
         return GP_ENOMEM;
     pk->disks = disks;
@@ -168,8 +168,13 @@ static int find_position(packer *pk, int32_t u, double R, int bridge_gap, double
 static void mark_failed(packer *pk, int32_t u, double R)
 {
     double limit = R;
+    const front_node *n = &pk->fr.nodes[u];
+    /* the limit is never below the smaller of R and R_min: a segment that already failed
+     * at or below that keeps its record whatever the limit, so it is not computed (the
+     * first segment of the front's level is tried on every pass, dead pocket or not) */
+    if (n->state == SEG_FAILED && !(fmin(R, pk->R_min) < n->fail_R))
+        return;
     if (pk->blocked >= 0) {
-        const front_node *n = &pk->fr.nodes[u];
         const gp_disk *a = &pk->disks[n->disk];
         gp_disk b_image, q_image;
         limit = pack_fit_limit(a, pack_image(pk, &pk->disks[pk->fr.nodes[n->next].disk], a->x, a->y, &b_image),
@@ -528,7 +533,8 @@ int gp_pack(const gp_pack_params *params, const gp_progress *progress, gp_packin
     else if (rc)
         gp_error_set(err, rc, NULL, "out of memory for the bucket grid");
     if (rc == 0) {
-        pk.disks = malloc(capacity * sizeof *pk.disks);
+        /* on a cache line: a disk (32 bytes) then never straddles two */
+        pk.disks = grow_aligned(NULL, 0, capacity, sizeof *pk.disks);
         pk.level = malloc(capacity * sizeof *pk.level);
         pk.closings = malloc(capacity * sizeof *pk.closings);
         pk.capacity = capacity;

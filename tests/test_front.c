@@ -132,7 +132,7 @@ static void test_close_across_splits_the_loop_in_two(void)
     int32_t on_a = front_node_on_loop(&fx.f, 4, node_of(&fx.f, 0));
     int32_t on_b = front_node_on_loop(&fx.f, 4, node_of(&fx.f, 1));
     CHECK(on_a != FRONT_NONE && on_b != FRONT_NONE && on_a != on_b);
-    CHECK(fx.f.nodes[node_of(&fx.f, 0)].loop != fx.f.nodes[node_of(&fx.f, 1)].loop);
+    CHECK(fx.f.cold[node_of(&fx.f, 0)].loop != fx.f.cold[node_of(&fx.f, 1)].loop);
     CHECK(front_node_on_loop(&fx.f, 2, node_of(&fx.f, 0)) == FRONT_NONE);
     CHECK(fx.f.active == 9);
     teardown(&fx);
