@@ -14,7 +14,13 @@
  * list is the same). */
 #define TESS_FORMAT "3.4"
 
-/* A hash of the weld grid's occupied buckets (side 2 tol): key -> first vertex. */
+/* The weld grid's cell side, in tol: cells far wider than tol, so that a vertex is
+ * compared with the vertices of its own cell only, unless it lies within tol of a side
+ * (one vertex in WELD_CELL_TOLS / 2 per axis); still far below the spacing of a cell's
+ * vertices (some 1e-1 R against tol = GP_TESS_WELD_RTOL R), so cells hold one vertex. */
+#define WELD_CELL_TOLS 256.0
+
+/* A hash of the weld grid's occupied buckets (side WELD_CELL_TOLS tol): key -> first vertex. */
 typedef struct bucket {
     int64_t key[3];
     uint32_t head;
@@ -72,16 +78,22 @@ static size_t bucket_slot(const tess *t, const int64_t k[3])
     return s;
 }
 
-/* The welded vertex within tol of p: an existing one in the 27 buckets around, or a new. */
+/* The welded vertex within tol of p: an existing one in its bucket or in the neighbouring
+ * buckets it lies within tol of, or a new. */
 static uint32_t weld(tess *t, const double *p)
 {
-    double h = 2.0 * t->tol;
+    double h = WELD_CELL_TOLS * t->tol;
     int64_t k[3];
-    for (int d = 0; d < 3; d++)
-        k[d] = (int64_t)floor(p[d] / h);
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dz = -1; dz <= 1; dz++) {
+    int lo[3], hi[3];
+    for (int d = 0; d < 3; d++) {
+        double cell = floor(p[d] / h);
+        k[d] = (int64_t)cell;
+        lo[d] = p[d] - cell * h <= t->tol ? -1 : 0;
+        hi[d] = (cell + 1.0) * h - p[d] <= t->tol ? 1 : 0;
+    }
+    for (int dx = lo[0]; dx <= hi[0]; dx++)
+        for (int dy = lo[1]; dy <= hi[1]; dy++)
+            for (int dz = lo[2]; dz <= hi[2]; dz++) {
                 int64_t q[3] = {k[0] + dx, k[1] + dy, k[2] + dz};
                 for (uint32_t v = t->buckets[bucket_slot(t, q)].head; v != NONE; v = t->vnext[v]) {
                     const double *w = &t->xyz[3 * (size_t)v];
