@@ -62,7 +62,7 @@ static void columns(const void *s, gp_job_columns *out)
                             0,
                             spec->seed,
                             spec->expected_spheres,
-                            0};
+                            spec->laguerre_enabled};
 }
 
 static json_t *validation(const void *s, const gp_config *cfg)
@@ -174,14 +174,12 @@ static int run(void *s, const gp_config *cfg, const gp_progress *progress, gp_pr
 }
 
 /* The formats every pack3d job is served in: its spheres (csv, json), its polyhedra or its
- * spheres (vtu), the section picture (svg). tess is served too, to a job that made
- * polyhedra; the links, which know no more of a job than whether its spec asked for a
- * mesh, do not list it. */
-static int serves(gp_format format, int has_mesh)
+ * spheres (vtu), the section picture (svg); and tess when its spec asked for polyhedra
+ * (`has_polyhedra`, the job's has_mesh column). */
+static int serves(gp_format format, int has_polyhedra)
 {
-    (void)has_mesh;
     return format == GP_FORMAT_JSON || format == GP_FORMAT_CSV || format == GP_FORMAT_VTU ||
-           format == GP_FORMAT_SVG;
+           format == GP_FORMAT_SVG || (format == GP_FORMAT_TESS && has_polyhedra);
 }
 
 /* The stored summary of a 3D result: counts and statistics, arrays NULL (sections.h). */

@@ -52,8 +52,8 @@ typedef struct gp_process_def {
     int (*run)(void *spec, const gp_config *cfg, const gp_progress *progress,
                gp_process_run *run, gp_error *err);
     void (*free_run)(gp_process_run *run);
-    /* Whether its results are served in `format` (for a job whose spec asked for a mesh
-     * when has_mesh): the status's links list those. */
+    /* Whether its results are served in `format` (for a job whose spec asked for its extra
+     * geometry, a 2D mesh or 3D polyhedra, when has_mesh): the status's links list those. */
     int (*serves)(gp_format format, int has_mesh);
     /* Answers GET /jobs/{id}/results in `format` from the stored result `res`, which it
      * takes over (freed here). Only reads what was stored: no geometry. Returns

@@ -63,7 +63,8 @@ typedef struct gp_job {
     char created[32], started[32], finished[32], updated[32];
     int progress; /* 0-100 */
     char message[256];
-    int has_mesh; /* the spec asks for a mesh: the job's results include msh and inp */
+    int has_mesh; /* the spec asks for its process's extra geometry: pack2d a mesh (msh, inp),
+                     pack3d polyhedra (tess); the status links list those formats */
     char process[16]; /* the process the spec is for: "pack3d" when its domain has a depth,
                          else "pack2d" (read from the stored spec, as processes.c tells it) */
 } gp_job;
@@ -172,7 +173,7 @@ typedef struct gp_job_columns {
     int level_band;
     uint64_t seed;
     double expected;          /* grains expected (disks or spheres) */
-    int has_mesh;             /* the job's results include msh and inp */
+    int has_mesh;             /* as gp_job's: a 2D mesh, or 3D polyhedra, asked for */
 } gp_job_columns;
 
 /* The columns of a 2D spec. */

@@ -17,7 +17,7 @@ static const char schema_v3[] =
     "  claims integer NOT NULL DEFAULT 0," /* times a node took it: > 1 after a requeue */
     "  error text,"
     "  spec text NOT NULL,"
-    "  has_mesh boolean NOT NULL DEFAULT false," /* the spec asks for a mesh */
+    "  has_mesh boolean NOT NULL DEFAULT false," /* the spec asks for a 2D mesh or 3D polyhedra */
     "  domain_width double precision NOT NULL, domain_height double precision NOT NULL,"
     "  distribution text NOT NULL, joint text NOT NULL, level_band integer NOT NULL,"
     "  seed bigint NOT NULL, expected_disks double precision NOT NULL,"

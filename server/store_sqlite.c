@@ -22,10 +22,14 @@
 #define WAL_SIZE_LIMIT (64 << 20)
 
 /* has_mesh: the spec asks for a mesh ("mesh" in the inputs, wrapped or bare: a bare spec
- * cannot hold "inputs"), so that a job lists the mesh formats only when it has them */
+ * cannot hold "inputs"), or for polyhedra (a box's "laguerre"), so that a job lists the
+ * mesh formats, or tess, only when it has them */
 /* process: "pack3d" when the spec's domain has a depth (gp_process_of_spec, processes.h) */
 #define JOB_COLUMNS "seq, id, status, created, started, finished, updated, progress, message," \
-                    " coalesce(json_type(spec, '$.inputs.mesh'), json_type(spec, '$.mesh')) IS NOT NULL," \
+                    " coalesce(json_type(spec, '$.inputs.mesh'), json_type(spec, '$.mesh'), CASE WHEN" \
+                    " coalesce(json_type(spec, '$.inputs.domain.depth'), json_type(spec, '$.domain.depth'))" \
+                    " IS NOT NULL THEN coalesce(json_type(spec, '$.inputs.laguerre')," \
+                    " json_type(spec, '$.laguerre')) END) IS NOT NULL," \
                     " CASE WHEN coalesce(json_type(spec, '$.inputs.domain.depth')," \
                     " json_type(spec, '$.domain.depth')) IS NULL THEN 'pack2d' ELSE 'pack3d' END"
 

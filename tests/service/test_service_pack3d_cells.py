@@ -157,6 +157,12 @@ def check_statistics(c, api, client, job):
     return st
 
 
+def result_links(info):
+    """The formats a job's status links its results in."""
+    rel = "http://www.opengis.net/def/rel/ogc/1.0/results"
+    return {lk["href"].split("f=")[1] for lk in info["links"] if lk["rel"] == rel and "f=" in lk["href"]}
+
+
 def test(c, binary, cli):
     api = gpd.OpenAPI()
     daemon = gpd.Daemon(binary, "--workers", "1")
@@ -169,6 +175,8 @@ def test(c, binary, cli):
         job = r.json()["jobID"]
         info = client.wait_final(job)
         if c.check(info["status"] == "successful", f"the pack3d job: {info}"):
+            links = result_links(client.get(f"/jobs/{job}").json())
+            c.check(links == {"csv", "svg", "vtu", "tess"}, f"status links of the cells job {sorted(links)}")
             st = check_statistics(c, api, client, job)
             with tempfile.TemporaryDirectory() as tmp:
                 check_downloads(c, api, client, cli, job, st, tmp)
@@ -176,6 +184,8 @@ def test(c, binary, cli):
         plain_spec = {"inputs": {k: v for k, v in spec3d()["inputs"].items() if k not in ("balance", "laguerre")}}
         plain = client.submit(plain_spec, "pack3d").json()["jobID"]
         if c.check(client.wait_final(plain)["status"] == "successful", "the packing-only job"):
+            links = result_links(client.get(f"/jobs/{plain}").json())
+            c.check(links == {"csv", "svg", "vtu"}, f"status links of the packing-only job {sorted(links)}")
             r = client.get(f"/jobs/{plain}/results?f=tess")
             gpd.check_problem(c, r, 400, BAD_PARAMETER, "laguerre", "tess of a job without cells")
             r = client.get(f"/jobs/{plain}/results?f=vtu")
