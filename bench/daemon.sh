@@ -16,6 +16,25 @@ base="http://127.0.0.1:$(cat "$dir/port")"
 load_start=$(cut -d' ' -f1 /proc/loadavg)
 rss() { awk -v k="$1:" '$1 == k {print $2}' "/proc/$pid/status"; }
 
+# download_rows URL FORMAT... - one markdown row a format: URL?f=FORMAT downloaded alone, its
+# bytes and time, and the daemon's RSS before, at its peak during and after the download.
+download_rows() {
+  local url=$1 fmt before out peak after total bytes
+  shift
+  echo "| format | bytes | time | RSS before | peak during | after | peak - before |"
+  echo "| --- | --- | --- | --- | --- | --- | --- |"
+  for fmt in "$@"; do
+    before=$(rss VmRSS)
+    echo 5 > "/proc/$pid/clear_refs"  # VmHWM counts from here
+    out=$(curl -s -o /dev/null -w '%{time_total} %{size_download}' "$url?f=$fmt")
+    peak=$(rss VmHWM)
+    after=$(rss VmRSS)
+    read -r total bytes <<< "$out"
+    python3 -c "print(f'| $fmt | {$bytes / 1e6:.1f} MB | {$total:.2f} s | {$before / 1024:.1f} MB |'
+                      f' {$peak / 1024:.1f} MB | {$after / 1024:.1f} MB | +{($peak - $before) / 1024:.1f} MB |')"
+  done
+}
+
 # concurrent_downloads N URL LABEL FORMAT... - N downloads of URL?f=FORMAT at once (the
 # formats in turn, every second one gzip) and one line: their time and the daemon's memory.
 concurrent_downloads() {

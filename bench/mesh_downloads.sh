@@ -26,18 +26,7 @@ m = json.load(sys.stdin)['mesh']
 print(m['nodes'], m['elements']['triangles'], m['elements']['quadrilaterals'])")
 read -r nodes tri quad <<< "$counts"
 
-echo "| format | bytes | time | RSS before | peak during | after | peak - before |"
-echo "| --- | --- | --- | --- | --- | --- | --- |"
-for fmt in msh inp vtu; do
-  before=$(rss VmRSS)
-  echo 5 > "/proc/$pid/clear_refs"  # VmHWM counts from here
-  out=$(curl -s -o /dev/null -w '%{time_total} %{size_download}' "$base$job/results?f=$fmt")
-  peak=$(rss VmHWM)
-  after=$(rss VmRSS)
-  read -r total bytes <<< "$out"
-  python3 -c "print(f'| $fmt | {$bytes / 1e6:.1f} MB | {$total:.2f} s | {$before / 1024:.1f} MB |'
-                    f' {$peak / 1024:.1f} MB | {$after / 1024:.1f} MB | +{($peak - $before) / 1024:.1f} MB |')"
-done
+download_rows "$base$job/results" msh inp vtu
 
 if [ "$concurrent" -gt 0 ]; then concurrent_downloads "$concurrent" "$base$job/results" "msh, inp, vtu in turn" msh inp vtu; fi
 echo

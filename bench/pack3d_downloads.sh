@@ -44,18 +44,7 @@ sqlite3 -separator ' ' "$dir/grainpack.db" "SELECT tag, bytes FROM result_sectio
 total=$(sqlite3 "$dir/grainpack.db" "SELECT sum(bytes) FROM result_sections")
 python3 -c "print(f'| all | {$total:,} | {$total / $n:.1f} |')"
 echo
-echo "| format | bytes | time | RSS before | peak during | after | peak - before |"
-echo "| --- | --- | --- | --- | --- | --- | --- |"
-for fmt in csv json vtu svg tess; do
-  before=$(rss VmRSS)
-  echo 5 > "/proc/$pid/clear_refs"  # VmHWM counts from here
-  out=$(curl -s -o /dev/null -w '%{time_total} %{size_download}' "$base$job/results?f=$fmt")
-  peak=$(rss VmHWM)
-  after=$(rss VmRSS)
-  read -r total_s bytes <<< "$out"
-  python3 -c "print(f'| $fmt | {$bytes / 1e6:.1f} MB | {$total_s:.2f} s | {$before / 1024:.1f} MB |'
-                    f' {$peak / 1024:.1f} MB | {$after / 1024:.1f} MB | +{($peak - $before) / 1024:.1f} MB |')"
-done
+download_rows "$base$job/results" csv json vtu svg tess
 echo
 echo "job: $n spheres in a box of side $side; stages $timings; daemon $GP_DAEMON"
 echo "load average $load_start at the start, $(cut -d' ' -f1 /proc/loadavg) at the end;" \
