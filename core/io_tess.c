@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "grainpack/io3d.h"
+#include "tess_conform.h"
 
 #define NONE UINT32_MAX
 /* The format version written: Neper 4.x writes and reads 3.4 (its documentation's field
@@ -19,6 +20,10 @@
  * (one vertex in WELD_CELL_TOLS / 2 per axis); still far below the spacing of a cell's
  * vertices (some 1e-1 R against tol = GP_TESS_WELD_RTOL R), so cells hold one vertex. */
 #define WELD_CELL_TOLS 256.0
+/* Passes of gp_tess_conform before the faces are taken as not conforming: each pass splits
+ * what the cells' own once-used edges show; one is the rule, a second when a split shows
+ * another cell's missing vertex. */
+#define CONFORM_PASSES 4
 
 /* A hash of the weld grid's occupied buckets (side WELD_CELL_TOLS tol): key -> first vertex. */
 typedef struct bucket {
@@ -137,6 +142,51 @@ static int64_t face_from(const tess *t, size_t nb, size_t i)
     return 0;
 }
 
+/* Splits the faces' edges at the vertices inside them (tess_conform.h). Returns 0, or
+ * GP_ENOMEM / GP_EGEOM with err set. */
+static int conform(tess *t, gp_error *err)
+{
+    const gp_cells3d *c = t->c;
+    tess_faces faces = {t->nf, t->fvstart, t->fverts, t->xyz, c->count, c->fstart, t->face_of};
+    long added = 0;
+    for (int pass = 0; pass <= CONFORM_PASSES; pass++) {
+        added = gp_tess_conform(&faces, t->tol);
+        t->fvstart = faces.fvstart; /* replaced when vertices were inserted */
+        t->fverts = faces.fverts;
+        if (added <= 0)
+            break;
+    }
+    if (added < 0)
+        return gp_error_set(err, (int)added, NULL, "out of memory for the tessellation");
+    if (added > 0)
+        return gp_error_set(err, GP_EGEOM, NULL, "the tessellation's faces stay non-conforming "
+                            "after %d passes", CONFORM_PASSES + 1);
+    return 0;
+}
+
+/* The edges of the welded faces, numbered as first met, and each face's signed edge ids. */
+static int make_edges(tess *t, gp_error *err)
+{
+    size_t uses = t->fvstart[t->nf];
+    int64_t *fedges = realloc(t->fedges, (uses + 1) * sizeof *fedges);
+    if (fedges)
+        t->fedges = fedges;
+    uint32_t *ev = realloc(t->ev, 2 * (uses + 1) * sizeof *ev);
+    if (ev)
+        t->ev = ev;
+    uint32_t *enext = realloc(t->enext, (uses + 1) * sizeof *enext);
+    if (enext)
+        t->enext = enext;
+    if (!fedges || !ev || !enext)
+        return gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the tessellation");
+    for (size_t f = 0; f < t->nf; f++) {
+        size_t a = t->fvstart[f], n = t->fvstart[f + 1] - a;
+        for (size_t k = 0; k < n; k++)
+            t->fedges[a + k] = edge(t, t->fverts[a + k], t->fverts[a + (k + 1) % n]);
+    }
+    return 0;
+}
+
 static int build(tess *t, gp_error *err)
 {
     const gp_cells3d *c = t->c;
@@ -192,8 +242,6 @@ static int build(tess *t, gp_error *err)
                 n--;
             if (n < 3)
                 continue; /* welded into an edge or a point: not a face */
-            for (size_t k = 0; k < n; k++)
-                t->fedges[at + k] = edge(t, t->fverts[at + k], t->fverts[at + (k + 1) % n]);
             t->fother[t->nf] = nb;
             t->frefs[t->nf] = 1;
             t->face_of[f] = (int64_t)++t->nf;
@@ -209,7 +257,8 @@ static int build(tess *t, gp_error *err)
             return gp_error_set(err, GP_EGEOM, NULL,
                                 "the face between grains %d and %d is not in both cells",
                                 (int)t->fother[f], (int)f);
-    return 0;
+    int rc = conform(t, err);
+    return rc ? rc : make_edges(t, err);
 }
 
 /* The unit normal (Newell's) and the plane offset of welded face f. */
