@@ -7,6 +7,10 @@
 
 #include "grainpack/error.h"
 
+/* How near a point bin (min = max: a constant law) a radius counts as in it: the drawn
+ * radii are the constant itself; a cell's equivalent radius 40 % larger is not. */
+#define POINT_BIN_RTOL 1e-12
+
 long gp_bin_table_find(const gp_bin_stat *bins, size_t n, double r)
 {
     size_t lo = 0, hi = n;
@@ -21,7 +25,9 @@ long gp_bin_table_find(const gp_bin_stat *bins, size_t n, double r)
         return -1;
     size_t i = lo - 1;
     int last = i + 1 == n;
-    if (r < bins[i].max || (last && r <= bins[i].max) || bins[i].min == bins[i].max)
+    if (bins[i].min == bins[i].max) /* a constant law's point: r itself, not what lies above */
+        return fabs(r - bins[i].min) <= POINT_BIN_RTOL * fabs(bins[i].min) ? (long)i : -1;
+    if (r < bins[i].max || (last && r <= bins[i].max))
         return (long)i;
     return -1;
 }

@@ -83,7 +83,8 @@ GP_API void gp_cell_stats_free(gp_cell_stats *stats);
  * with zero counts. Returns 0 or GP_ENOMEM; *bins is the caller's to free. */
 GP_API int gp_bin_table_init(const gp_distribution *dist, gp_bin_stat **bins, size_t *nbins);
 
-/* The bin holding r among bins sorted by min, or -1 when r lies in none of them. */
+/* The bin holding r among bins sorted by min, or -1 when r lies in none of them. A point
+ * bin (min = max, a constant law) holds r only within a relative 1e-12 of its value. */
 GP_API long gp_bin_table_find(const gp_bin_stat *bins, size_t nbins, double r);
 
 /* Fills `achieved`, `se` and `z` of every bin from its count out of n values, and *max_abs_z. */
