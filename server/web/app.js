@@ -1,5 +1,5 @@
-// app.js - the page's entry: reads what the service is (GET /health, the process
-// description), builds the three views, switches between them with the address's hash
+// app.js - the page's entry: reads what the service is (GET /health, its processes and the
+// first one's description), builds the three views, switches between them with the address's hash
 // (#design, #job/ID, #jobs: a job can be linked to; the key never appears in it), and
 // keeps the API key of this tab.
 
@@ -10,6 +10,8 @@ import { JobView } from './job.js';
 import { JobsView } from './jobs.js';
 
 const views = ['design', 'job', 'jobs'];
+// The process the design view shows first: the report's own, disks in a rectangle.
+const FIRST_PROCESS = 'pack2d';
 let design = null;
 let job = null;
 let jobs = null;
@@ -81,10 +83,11 @@ function setupKey() {
 
 async function start() {
   setupKey();
-  const [process] = await Promise.all([getJSON('/processes/pack2d'), refreshHealth()]);
+  // the list and the first process's description at once; the others' when chosen
+  const [list, first] = await Promise.all([getJSON('/processes'), getJSON(`/processes/${FIRST_PROCESS}`), refreshHealth()]);
   job = new JobView(document.getElementById('job'), { onChanged: () => refreshHealth() });
   jobs = new JobsView(document.getElementById('jobs'));
-  design = new DesignView(document.getElementById('design'), process, {
+  design = new DesignView(document.getElementById('design'), list.processes, first, {
     onSubmitted: (info) => { location.hash = `job/${encodeURIComponent(info.jobID)}`; },
   });
   window.addEventListener('hashchange', () => showView(route(), true));

@@ -1,31 +1,46 @@
-// design.js - the Design view: the job's inputs as a form made from the process
-// description, the target law and the joint j(r) drawn as they are typed, the service's
-// own validation (POST /processes/pack2d/validation) giving the expected number of disks
-// or the problem next to its field, and the submission.
+// design.js - the Design view: the process (disks in a rectangle, spheres in a box: the
+// service's list), the job's inputs as a form made from its description, the target law
+// and the joint j(r) drawn as they are typed, the service's own validation (POST
+// /processes/{id}/validation) giving the expected number of grains or the problem next
+// to its field, and the submission.
 
 import { describe, getJSON, request } from './api.js';
 import { binsChart, curveChart } from './charts.js';
 import { announce, debounce, el, fmtInt } from './dom.js';
 import { makeInput } from './form.js';
 
-const PROCESS = '/processes/pack2d';
 // Validation waits for this pause in the typing (ms): one request per burst of keys.
 const VALIDATE_DELAY = 300;
 // Samples of the j(r) curve.
 const CURVE_POINTS = 64;
-// What the form holds before anything is chosen: the report's fixed case.
+// What the form of each process holds before anything is chosen: the report's fixed case
+// in 2D; in 3D a small box of equal spheres (about 900), quick to run and to look at.
 const START = {
-  domain: { width: 100, height: 100 },
-  distribution: { kind: 'constant', radius: 0.9 },
-  joint: { law: 'constant', value: 0.1 },
-  seed: 1,
+  pack2d: {
+    domain: { width: 100, height: 100 },
+    distribution: { kind: 'constant', radius: 0.9 },
+    joint: { law: 'constant', value: 0.1 },
+    seed: 1,
+  },
+  pack3d: {
+    domain: { width: 10, height: 10, depth: 10 },
+    distribution: { kind: 'constant', radius: 0.5 },
+    joint: { law: 'constant', value: 0.05 },
+    seed: 1,
+  },
 };
-const EXAMPLES = [
-  ['fixed', 'the report’s fixed radius (2789 grains)'],
-  ['variable', 'the report’s three bins'],
-  ['iron', 'the report’s iron, 12 bins, j = 2 / r'],
-  ['bagi', 'Bagi’s uniform law (37,000 grains)'],
-];
+// The examples offered for each process (served at /ui/example-NAME.json).
+const EXAMPLES = {
+  pack2d: [
+    ['fixed', 'the report’s fixed radius (2789 grains)'],
+    ['variable', 'the report’s three bins'],
+    ['iron', 'the report’s iron, 12 bins, j = 2 / r'],
+    ['bagi', 'Bagi’s uniform law (37,000 grains)'],
+  ],
+  pack3d: [
+    ['iron3d', 'iron in a box of 80, balanced, offset polyhedra'],
+  ],
+};
 
 // The radii a law can draw: [lo, hi] (lo = hi for a constant radius), or null while the
 // law is not complete.
@@ -63,23 +78,24 @@ function thickness(joint, r) {
 }
 
 export class DesignView {
-  constructor(root, process, { onSubmitted }) {
+  // `processes`: the service's list (GET /processes); `first`: the description of the
+  // first one, shown at once; the others' are fetched when chosen.
+  constructor(root, processes, first, { onSubmitted }) {
     this.root = root;
     this.onSubmitted = onSubmitted;
     this.controls = new Map();
+    this.descriptions = new Map([[first.id, first]]);
+    this.kept = new Map(); // the inputs typed for each process, while another is shown
     this.ready = false;
     this.scheduleValidation = debounce(() => this.validate(), VALIDATE_DELAY);
-    const onChange = () => this.changed();
-    const fields = el('div', { class: 'fields' });
-    for (const [name, description] of Object.entries(process.inputs || {})) {
-      const control = makeInput(`/inputs/${name}`, name, description, onChange);
-      this.controls.set(name, control);
-      fields.append(control.node);
-    }
+    this.fields = el('div', { class: 'fields' });
     const exampleId = 'example';
-    this.example = el('select', { id: exampleId, onchange: () => this.loadExample() },
-      el('option', { value: '' }, 'choose…'),
-      EXAMPLES.map(([name, label]) => el('option', { value: name }, label)));
+    this.example = el('select', { id: exampleId, onchange: () => this.loadExample() });
+    this.exampleField = el('div', { class: 'field start' }, el('label', { for: exampleId }, 'Start from an example'), this.example);
+    this.processChoice = el('fieldset', { class: 'group process' }, el('legend', {}, 'What to pack'),
+      processes.map((p) => el('label', { class: 'choice' },
+        el('input', { type: 'radio', name: 'process', value: p.id, checked: p.id === first.id, onchange: () => this.choose(p.id) }),
+        ` ${p.title}`)));
     this.targetPlot = el('figure', { class: 'plot' });
     this.jointPlot = el('figure', { class: 'plot' });
     this.expected = el('p', { class: 'expected', role: 'status', 'aria-live': 'polite' }, 'Checking the design…');
@@ -89,20 +105,58 @@ export class DesignView {
     this.submitButton = el('button', { type: 'submit', class: 'primary' }, 'Submit the job');
     this.form = el('form', { class: 'design', novalidate: true, onsubmit: (e) => this.submit(e) },
       el('div', { class: 'design-grid' },
-        el('div', { class: 'design-fields' },
-          el('div', { class: 'field start' }, el('label', { for: exampleId }, 'Start from an example'), this.example),
-          fields),
+        el('div', { class: 'design-fields' }, this.processChoice, this.exampleField, this.fields),
         el('aside', { class: 'design-side', 'aria-label': 'Preview and submission' },
           this.targetPlot, this.jointPlot,
           el('div', { class: 'summary' }, this.expected, this.message, this.submitButton,
             el('details', {}, el('summary', {}, 'The request, as the service reads it'), this.normalised,
               el('p', {}, 'The same from a terminal:'), this.curl)))));
     root.append(this.form);
+    const onChange = () => this.changed();
     this.form.addEventListener('input', onChange);
     this.form.addEventListener('change', onChange);
-    this.setValues(START);
+    this.show(first);
+  }
+
+  get path() {
+    return `/processes/${this.process.id}`;
+  }
+
+  // Builds the form of process description `process`, holding what was typed for it before
+  // (or its start values).
+  show(process) {
+    this.ready = false;
+    this.process = process;
+    this.controls.clear();
+    this.fields.replaceChildren();
+    const onChange = () => this.changed();
+    for (const [name, description] of Object.entries(process.inputs || {})) {
+      const control = makeInput(`/inputs/${name}`, name, description, onChange);
+      this.controls.set(name, control);
+      this.fields.append(control.node);
+    }
+    const examples = EXAMPLES[process.id] || [];
+    this.example.replaceChildren(el('option', { value: '' }, 'choose…'),
+      ...examples.map(([name, label]) => el('option', { value: name }, label)));
+    this.exampleField.hidden = examples.length === 0;
+    this.clearErrors();
+    this.setValues(this.kept.get(process.id) || START[process.id] || {});
     this.ready = true;
     this.changed();
+  }
+
+  // The process radio `id` was chosen: its form, its description fetched the first time.
+  async choose(id) {
+    if (this.process && id === this.process.id) return;
+    if (this.process) this.kept.set(this.process.id, this.collect());
+    try {
+      if (!this.descriptions.has(id)) this.descriptions.set(id, await getJSON(`/processes/${encodeURIComponent(id)}`));
+    } catch (err) {
+      this.showMessage(describe(err));
+      return;
+    }
+    this.show(this.descriptions.get(id));
+    announce(`${this.descriptions.get(id).title}: its form is shown`);
   }
 
   // The inputs object the form describes (properties left empty are left out).
@@ -162,21 +216,27 @@ export class DesignView {
     el('figcaption', {}, 'The grain boundary j(r) over the radii the law draws: each grain is packed with R = r + j(r)'));
   }
 
-  // Asks the service whether the design is a valid job, and how many disks it expects.
+  // Asks the service whether the design is a valid job, and how many grains it expects.
   async validate() {
     const inputs = this.collect();
     if (this.pending) this.pending.abort();
     const pending = new AbortController();
     this.pending = pending;
+    const path = this.path;
     try {
-      const answer = await getJSON(`${PROCESS}/validation`, { method: 'POST', body: { inputs }, signal: pending.signal });
+      const answer = await getJSON(`${path}/validation`, { method: 'POST', body: { inputs }, signal: pending.signal });
+      if (path !== this.path) return; // the process changed meanwhile
       this.clearErrors();
-      this.expected.replaceChildren(el('strong', {}, `≈ ${fmtInt(answer.expected_disks)} disks expected`),
-        ` (the service’s estimate, on the high side; at most ${fmtInt(answer.limits && answer.limits.max_disks)} a job)`);
+      // 2D answers in disks, 3D in spheres
+      const spheres = answer.expected_spheres !== undefined;
+      const limits = answer.limits || {};
+      this.expected.replaceChildren(
+        el('strong', {}, `≈ ${fmtInt(spheres ? answer.expected_spheres : answer.expected_disks)} ${spheres ? 'spheres' : 'disks'} expected`),
+        ` (the service’s estimate, on the high side; at most ${fmtInt(spheres ? limits.max_spheres : limits.max_disks)} a job)`);
       this.normalised.textContent = JSON.stringify({ inputs: answer.inputs }, null, 1);
-      this.curl.textContent = `curl -s -H 'Content-Type: application/json' -d '${JSON.stringify({ inputs })}' ${location.origin}${PROCESS}/execution`;
+      this.curl.textContent = `curl -s -H 'Content-Type: application/json' -d '${JSON.stringify({ inputs })}' ${location.origin}${path}/execution`;
     } catch (err) {
-      if (err.name === 'AbortError') return;
+      if (err.name === 'AbortError' || path !== this.path) return;
       this.expected.textContent = 'No estimate until the design is valid.';
       if (err.status === 400 || err.status === 422) this.showProblem(err.problem);
       else this.showMessage(describe(err));
@@ -236,7 +296,7 @@ export class DesignView {
     event.preventDefault();
     this.submitButton.disabled = true;
     try {
-      const response = await request(`${PROCESS}/execution`, { method: 'POST', body: { inputs: this.collect() } });
+      const response = await request(`${this.path}/execution`, { method: 'POST', body: { inputs: this.collect() } });
       const info = await response.json();
       this.message.replaceChildren();
       this.onSubmitted(info);

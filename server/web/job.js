@@ -1,6 +1,7 @@
 // job.js - the Job view: watch a job (its status and progress, live through the
 // long-poll GET /jobs/{id}?wait=), dismiss it, then look at what it made: the picture
-// (coloured by radius or by F), the statistics beside it, and every download.
+// (2D: coloured by radius or by F; 3D: the section of the box its spec asked for), the
+// statistics beside it (a 3D job's cells are polyhedra), and every download.
 
 import { describe, getBlob, getJSON, getKey, request } from './api.js';
 import { binsChart, countsChart } from './charts.js';
@@ -164,8 +165,13 @@ export class JobView {
     const numbers = el('section', { class: 'panel stats', 'aria-labelledby': 'stats-h' }, el('h2', { id: 'stats-h' }, 'Statistics'));
     const downloads = el('section', { class: 'panel downloads', 'aria-labelledby': 'dl-h' }, el('h2', { id: 'dl-h' }, 'Downloads'));
     this.result.replaceChildren(el('div', { class: 'look' }, picture, numbers), downloads);
-    this.fillPicture(picture, stats);
-    this.fillStatistics(numbers, stats);
+    if (info.processID === 'pack3d') {
+      this.fillSection(picture);
+      this.fillStatistics(numbers, stats, true);
+    } else {
+      this.fillPicture(picture, stats);
+      this.fillStatistics(numbers, stats, false);
+    }
     this.fillDownloads(downloads, info);
   }
 
@@ -200,13 +206,29 @@ export class JobView {
     }
   }
 
-  fillStatistics(section, s) {
+  // A 3D job's picture: the section of the box by the plane of its spec ("picture":
+  // {"section"}), one layer of grains (a small SVG whatever the job's size), drawn at once.
+  fillSection(section) {
+    const viewer = new Viewer(`section of job ${this.id}`);
+    const note = el('p', { class: 'note', role: 'status' }, 'Drawing…');
+    section.append(viewer.node, note);
+    getBlob(`/jobs/${encodeURIComponent(this.id)}/results?f=svg`, 'image/svg+xml').then(async (blob) => {
+      // the picture's own title names the plane: "... section z = 5 (x to the right, y up)"
+      const title = /<title>[^<]*section ([^<]*)<\/title>/.exec(await blob.slice(0, 1024).text());
+      if (this.pictureUrl) URL.revokeObjectURL(this.pictureUrl);
+      this.pictureUrl = URL.createObjectURL(blob);
+      viewer.show(this.pictureUrl);
+      note.textContent = title ? `The box cut by the plane ${title[1]}.` : '';
+    }).catch((err) => { note.textContent = describe(err); });
+  }
+
+  fillStatistics(section, s, three) {
     const dist = s.distribution || {};
     const radius = s.radius || {};
     section.append(el('dl', { class: 'figures' },
       ...figure('grains', fmtInt(s.count)),
-      ...figure('packing density', fmtNum(s.packing_density, 4), 'sum of π R² over the domain area'),
-      ...figure('grain fraction', fmtNum(s.grain_fraction, 4), 'sum of π r² over the domain area'),
+      ...figure('packing density', fmtNum(s.packing_density, 4), three ? 'sum of 4/3 π R³ over the box volume' : 'sum of π R² over the domain area'),
+      ...figure('grain fraction', fmtNum(s.grain_fraction, 4), three ? 'sum of 4/3 π r³ over the box volume' : 'sum of π r² over the domain area'),
       ...figure('radius r: min / mean / max', `${fmtNum(radius.min)} / ${fmtNum(radius.mean)} / ${fmtNum(radius.max)}`),
       ...figure('χ² (degrees of freedom)', `${fmtNum(dist.chi2, 4)} (${dist.dof})`, 'Pearson’s statistic of the achieved against the target bins'),
       ...figure('p-value', fmtNum(dist.p_value, 3)),
@@ -221,7 +243,8 @@ export class JobView {
         dist.bins.map((b) => [fmtNum(b.min), fmtNum(b.max), fmtNum(b.target), fmtNum(b.achieved), fmtNum(b.se, 3), fmtNum(b.z, 3)])));
     }
     if (s.balance) this.fillBalance(section, s.balance);
-    if (s.cells) this.fillCells(section, s.cells);
+    if (s.cells && three) this.fillPolyhedra(section, s.cells);
+    else if (s.cells) this.fillCells(section, s.cells);
   }
 
   fillBalance(section, b) {
@@ -263,6 +286,37 @@ export class JobView {
       section.append(el('figure', { class: 'plot' },
         binsChart({ bins: req.bins, achieved: true, title: 'Equivalent radii of the cells against the law', xLabel: 'equivalent radius sqrt(area / π)' }),
         el('figcaption', {}, `The cells’ equivalent radii in the law’s bins (${fmtInt(req.outside)} outside every bin)`)));
+    }
+  }
+
+  // A 3D job's Laguerre polyhedra: volumes, faces, the boundary phase, equivalent radii.
+  fillPolyhedra(section, c) {
+    const volume = c.volume || {};
+    const faces = c.faces_per_cell || {};
+    const req = c.equivalent_radius || {};
+    section.append(el('h3', {}, 'Laguerre polyhedra'), el('dl', { class: 'figures' },
+      ...figure('polyhedra', fmtInt(c.count)),
+      ...figure('shrink', c.shrink),
+      ...figure('grain-boundary phase', fmtPercent(c.boundary_fraction, 2), 'share of the box between the polyhedra'),
+      ...figure('cell volume: min / mean / max', `${fmtNum(volume.min)} / ${fmtNum(volume.mean)} / ${fmtNum(volume.max)}`),
+      ...figure('faces per cell (mean)', fmtNum(faces.mean, 3)),
+      ...figure('neighbours per cell (mean)', fmtNum(c.neighbours_mean, 3), 'faces shared with another cell; the others lie on the walls'),
+      ...figure('equivalent radius / r (mean)', fmtNum(req.mean_ratio, 4), 'the radius of the sphere of the cell’s volume over its grain’s radius')));
+    const hist = faces.histogram || [];
+    if (hist.length) {
+      section.append(el('figure', { class: 'plot' },
+        countsChart({ series: [{ lo: -0.5, hi: hist.length - 0.5, counts: hist, label: 'cells', cls: 'after' }], title: 'Faces per cell', xLabel: 'faces' }),
+        el('figcaption', {}, 'How many cells have k faces')));
+    }
+    if (Array.isArray(volume.histogram) && volume.histogram.length && volume.max > volume.min) {
+      section.append(el('figure', { class: 'plot' },
+        countsChart({ series: [{ lo: volume.min, hi: volume.max, counts: volume.histogram, label: 'cells', cls: 'after' }], title: 'Cell volumes', xLabel: 'volume of the shrunk cell' }),
+        el('figcaption', {}, 'How many cells have each volume')));
+    }
+    if (Array.isArray(req.bins) && req.bins.length) {
+      section.append(el('figure', { class: 'plot' },
+        binsChart({ bins: req.bins, achieved: true, title: 'Equivalent radii of the cells against the law', xLabel: 'equivalent radius (3 V / 4 π)^(1/3)' }),
+        el('figcaption', {}, `The cells’ equivalent radii in the law’s bins${req.outside !== undefined ? ` (${fmtInt(req.outside)} outside every bin)` : ''}`)));
     }
   }
 

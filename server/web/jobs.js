@@ -24,7 +24,7 @@ export class JobsView {
         el('button', { type: 'button', onclick: () => this.reload() }, 'Refresh')),
       el('div', { class: 'table-wrap' }, el('table', { class: 'jobs' },
         el('caption', { class: 'visually-hidden' }, 'Your jobs, newest first'),
-        el('thead', {}, el('tr', {}, ['Job', 'Status', 'Progress', 'Submitted', 'Actions'].map((h) => el('th', { scope: 'col' }, h)))),
+        el('thead', {}, el('tr', {}, ['Job', 'Process', 'Status', 'Progress', 'Submitted', 'Actions'].map((h) => el('th', { scope: 'col' }, h)))),
         this.body)),
       this.note,
       el('nav', { class: 'pager', 'aria-label': 'pages of jobs' }, this.newer, this.older));
@@ -81,6 +81,7 @@ export class JobsView {
     const label = active ? 'Dismiss' : 'Delete';
     return el('tr', {},
       el('td', {}, el('a', { href: `#job/${encodeURIComponent(job.jobID)}` }, el('code', {}, job.jobID))),
+      el('td', {}, job.processID || ''),
       el('td', {}, el('span', { class: `badge ${job.status}` }, job.status)),
       el('td', {}, active ? `${job.progress || 0} % ${job.message || ''}` : job.message || ''),
       el('td', {}, fmtTime(job.created)),

@@ -4,7 +4,8 @@
 // database). Scenarios of issue 14: design the iron histogram by pasting its bins, see the
 // expected disks, an invalid bin's error next to its field, submit, progress to success,
 // the picture and the achieved histogram, zoom from the keyboard, download the CSV;
-// dismiss a long job; My jobs; the keyboard alone; a narrow window; axe-core finds no
+// dismiss a long job; My jobs; the keyboard alone; a 3D job (issue 17) with its
+// section, polyhedra and .tess; a narrow window; axe-core finds no
 // serious or critical violation; with API keys, one user's page does not list another's
 // jobs. No console error anywhere; every refused request is one the scenario expects.
 // Usage: node page_test.mjs CONFIG.json (see test_web_browser.py for its fields)
@@ -292,6 +293,67 @@ async function keyboard(page) {
   await page.locator('#view-job .badge.successful').waitFor({ timeout: JOB });
 }
 
+const expectedSpheres = async (base, inputs) => {
+  const r = await fetch(`${base}/processes/pack3d/validation`, {
+    method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ inputs }),
+  });
+  return (await r.json()).expected_spheres;
+};
+
+// A 3D job from the page: the process chosen among the service's, its own form (a depth,
+// polyhedra), the estimate in spheres, the submission; the section drawn, the polyhedra's
+// statistics, the .tess and VTU offered and the .tess downloaded; back in 2D the design
+// typed before is still there.
+async function threeD(page) {
+  await fresh(page, config.open, '#design');
+  await shownDisks(page);
+  await page.getByLabel('Width').fill('123');
+  await page.getByLabel('Pack a box with spheres (advancing front)').check();
+  await page.getByLabel('Depth').waitFor({ timeout: STEP });
+  check(await page.getByLabel('Width').inputValue() === '10', '3D does not start from its own box');
+  const box = { width: 6, height: 5, depth: 4 };
+  for (const [name, v] of Object.entries(box)) await page.getByLabel(name[0].toUpperCase() + name.slice(1)).fill(String(v));
+  await page.getByLabel('Laguerre polyhedra').check();
+  await page.locator('select[name=shrink]').selectOption('offset');
+  const inputs = { domain: box, distribution: { kind: 'constant', radius: 0.5 }, joint: { law: 'constant', value: 0.05 }, seed: 1, laguerre: { shrink: 'offset' } };
+  const want = await expectedSpheres(config.open, inputs);
+  const shown = await shownDisks(page, want);
+  check(shown === want, `the page shows ${shown} expected spheres, the service says ${want}`);
+  check((await page.locator('.expected strong').textContent()).includes('spheres expected'), 'the 3D estimate is not in spheres');
+  await shot(page, 'design-3d', false);
+  await page.getByRole('button', { name: 'Submit the job' }).click();
+  await page.waitForURL(/#job\//, { timeout: STEP });
+  const id = decodeURIComponent(new URL(page.url()).hash.slice('#job/'.length));
+  await page.locator('#view-job .badge.successful').waitFor({ timeout: JOB });
+  await page.waitForFunction(() => {
+    const img = document.querySelector('.viewer img');
+    return img && img.complete && img.naturalWidth > 0;
+  }, null, { timeout: JOB });
+  await page.locator('.picture-panel .note', { hasText: 'The box cut by the plane z = ' }).waitFor({ timeout: STEP });
+  const stats = await (await fetch(`${config.open}/jobs/${id}/statistics`)).json();
+  const text = (await page.locator('.stats').textContent()).replace(/,/g, '');
+  check(text.includes(`grains${stats.count}`) && text.includes(`polyhedra${stats.cells.count}`), `3D figures: ${text.slice(0, 300)}`);
+  check(text.includes('grain-boundary phase') && text.includes('faces per cell'), 'no polyhedra statistics');
+  check(await page.locator('.stats svg.chart').count() >= 3, 'the 3D statistics draw fewer than 3 charts');
+  check(await page.getByLabel('Colour by').count() === 0, 'a 3D section offers a colouring it does not have');
+  const formats = await page.locator('.download-list a').allTextContents();
+  check(['JSON', 'CSV', 'SVG', 'VTU', 'TESS'].every((f) => formats.includes(f)), `3D downloads offered: ${formats}`);
+  await shot(page, 'result-3d');
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: STEP }),
+    page.getByRole('link', { name: 'TESS', exact: true }).click()]);
+  const tess = path.join(config.out, 'box.tess');
+  await download.saveAs(tess);
+  check(download.suggestedFilename() === `job-${id}.tess`, `the .tess is saved as ${download.suggestedFilename()}`);
+  // back to the design: 3D is still chosen; 2D holds what was typed in it
+  await page.goto(`${config.open}/#design`);
+  check(await page.getByLabel('Depth').inputValue() === '4', 'the 3D design was lost on the way back');
+  await page.getByLabel('Pack a rectangle with disks (advancing front)').check();
+  await page.getByLabel('Depth').waitFor({ state: 'detached', timeout: STEP });
+  check(await page.getByLabel('Width').inputValue() === '123', 'the 2D design was lost across the switch');
+  await axe(page, 'design-3d-back');
+  return { id, tess };
+}
+
 async function narrow(page) {
   await page.setViewportSize(NARROW);
   for (const hash of ['#design', '#jobs']) {
@@ -332,9 +394,10 @@ async function openService(dir) {
   await myJobs(page, [iron.id, long]);
   await axe(page, 'jobs');
   await keyboard(page);
+  const box = await threeD(page);
   await narrow(page);
   await context.close();
-  return { iron: iron.id, csv: iron.csv, long };
+  return { iron: iron.id, csv: iron.csv, long, box: box.id, tess: box.tess };
 }
 
 // With API keys: alice's jobs are hers; bob's page does not list them or open them.

@@ -108,7 +108,7 @@ def check_files(c, api, client):
     print(f"the page's {len(web_files())} files: {total} bytes")
     missing = referenced_files() - set(web_files())
     c.check(not missing, f"the page loads files the service does not have: {missing}")
-    for example in ("fixed", "variable", "iron", "bagi"):
+    for example in ("fixed", "variable", "iron", "bagi", "iron3d"):
         r = client.get(f"/ui/example-{example}.json")
         c.check(r.status == 200 and r.body == open(os.path.join(gpd.EXAMPLES, f"{example}.json"), "rb").read(),
                 f"/ui/example-{example}.json: {r}")

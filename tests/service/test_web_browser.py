@@ -4,7 +4,8 @@ and with API keys for alice and bob) and runs tests/browser/page_test.mjs, which
 Debian's chromium headless through the page (playwright-core and axe-core from npm,
 pinned in tests/browser/package-lock.json). Then checks what the browser left: the CSV
 files it downloaded parse, hold the job's disks (as many as its statistics say, none
-overlapping) and equal the service's own CSV; the long job is dismissed and the one deleted
+overlapping) and equal the service's own CSV; the 3D job's .tess is the service's and a
+valid tessellation of its box (tests/tess_reader.py); the long job is dismissed and the one deleted
 from My jobs is gone from the database; alice's job is hers. Screenshots, the downloads
 and outcome.json (first paint, transfer size, axe counts) are left in OUT_DIR.
 Usage: test_web_browser.py GRAINPACKD NODE CHROMIUM OUT_DIR"""
@@ -12,9 +13,13 @@ Usage: test_web_browser.py GRAINPACKD NODE CHROMIUM OUT_DIR"""
 import json
 import os
 import subprocess
+import sys
 import tempfile
 
 import gpd
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import tess_reader  # noqa: E402
 
 BROWSER_DIR = os.path.join(gpd.ROOT, "tests", "browser")
 # The long job: a square of this side filled with disks of radius 0.5 (about 1.9 million
@@ -33,6 +38,19 @@ def check_csv(c, client, job, path, what):
     c.check(len(disks) == stats["count"], f"{what}: {len(disks)} disks in the CSV, {stats['count']} in the statistics")
     c.check(not gpd.find_overlaps(disks), f"{what}: overlapping disks in the downloaded CSV")
     c.check(text == client.get(f"/jobs/{job}/results?f=csv").body.decode(), f"{what}: the download is not the service's CSV")
+
+
+def check_tess(c, client, job, path):
+    """The .tess the browser saved (the 3D job of page_test.mjs, a box of 6 x 5 x 4): the
+    service's bytes, and for the independent reader a valid tessellation of the box with a
+    polyhedron a sphere."""
+    with open(path, "rb") as f:
+        body = f.read()
+    c.check(body == client.get(f"/jobs/{job}/results?f=tess").body, "the 3D job's .tess is not the service's")
+    count = client.get(f"/jobs/{job}/statistics").json()["count"]
+    t = tess_reader.read(path)
+    bad = tess_reader.check(t, (6, 5, 4))
+    c.check(not bad and t.ncells == count, f".tess: {t.ncells} cells for {count} spheres; {bad[:3]}")
 
 
 def test(c, binary, node, chromium, out_dir):
@@ -68,6 +86,7 @@ def test(c, binary, node, chromium, out_dir):
             client = open_daemon.client()
             if opened:
                 check_csv(c, client, opened["iron"], opened["csv"], "the iron job's CSV")
+                check_tess(c, client, opened["box"], opened["tess"])
                 c.check(client.get(f"/jobs/{opened['long']}").status == 404, "the dismissed job deleted from My jobs is still there")
                 statuses = gpd.check_store(c, open_daemon, "after the browser")
                 c.check(opened["long"] not in statuses, "the deleted job is still in the database")
@@ -76,7 +95,8 @@ def test(c, binary, node, chromium, out_dir):
                 alice, bob = keys_daemon.client(keys["alice"]), keys_daemon.client(keys["bob"])
                 check_csv(c, alice, keyed["id"], keyed["csv"], "alice's CSV, downloaded with her key")
                 c.check(bob.get(f"/jobs/{keyed['id']}").status == 404, "bob sees alice's job")
-            for name in ("design", "design-invalid-bin", "running", "result", "jobs", "narrow-design", "keys-bob"):
+            for name in ("design", "design-invalid-bin", "running", "result", "jobs", "narrow-design", "keys-bob",
+                         "design-3d", "result-3d"):
                 png = os.path.join(out_dir, f"{name}.png")
                 c.check(os.path.exists(png) and os.path.getsize(png) > 10000, f"screenshot {name}.png is missing")
             c.check(open_daemon.stop() == 0, "the open grainpackd did not stop cleanly")
