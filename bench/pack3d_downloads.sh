@@ -4,8 +4,9 @@
 # joint 0.05, offset cells; GP_SPHERES, default 80000; GP_BALANCE=1 balances first) is run
 # once; the stored bytes of each section (and per sphere), the stage timings (with "tess",
 # the worker's rendering of the .tess), then each format downloaded alone: the daemon's
-# RSS before, its peak during the download (VmHWM, reset before each) and after. Prints
-# markdown. Not a test: run by hand (docs/3d.md §10 has the figures).
+# RSS before, its peak during the download (VmHWM, reset before each) and after; then 8
+# concurrent downloads (vtu, json, svg, tess in turn, half gzip) and the daemon's peak.
+# Prints markdown. Not a test: run by hand (docs/3d.md §10 has the figures).
 # Usage: bash bench/pack3d_downloads.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -45,6 +46,7 @@ total=$(sqlite3 "$dir/grainpack.db" "SELECT sum(bytes) FROM result_sections")
 python3 -c "print(f'| all | {$total:,} | {$total / $n:.1f} |')"
 echo
 download_rows "$base$job/results" csv json vtu svg tess
+concurrent_downloads 8 "$base$job/results" "vtu, json, svg, tess in turn" vtu json svg tess
 echo
 echo "job: $n spheres in a box of side $side; stages $timings; daemon $GP_DAEMON"
 echo "load average $load_start at the start, $(cut -d' ' -f1 /proc/loadavg) at the end;" \

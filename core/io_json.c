@@ -256,6 +256,16 @@ static void json_string_out(gp_out *out, const char *s, size_t len)
     gp_out_char(out, '"');
 }
 
+void gp_out_json_F(gp_out *out, double F)
+{
+    if (isnan(F)) {
+        GP_OUT_LITERAL(out, ",\"F\":null");
+    } else {
+        GP_OUT_LITERAL(out, ",\"F\":");
+        gp_out_double(out, F);
+    }
+}
+
 void gp_out_json(gp_out *out, const json_t *value)
 {
     switch (json_typeof(value)) {
@@ -339,14 +349,8 @@ static void disk(gp_writer *w, gp_out *out, const gp_grain_window *win, size_t j
     field(out, ",\"y\":", d->y);
     field(out, ",\"r\":", d->r);
     field(out, ",\"R\":", d->R);
-    if (w->result->has_balance) {
-        /* F is defined for interior centres only (balance.h) */
-        double F = win->F[j];
-        if (isnan(F))
-            GP_OUT_LITERAL(out, ",\"F\":null");
-        else
-            field(out, ",\"F\":", F);
-    }
+    if (w->result->has_balance)
+        gp_out_json_F(out, win->F[j]);
     gp_out_char(out, '}');
 }
 

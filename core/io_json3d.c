@@ -1,10 +1,12 @@
 /* io_json3d.c - the 3D result as JSON: the spec's inputs, the statistics (built with
- * jansson: small), then the spheres and polyhedra streamed with shortest doubles. */
+ * jansson: small), then the spheres and polyhedra streamed window by window (writer3d.h)
+ * with shortest doubles. */
 #include <math.h>
 #include <string.h>
 
 #include "grainpack/io3d.h"
 #include "json_values.h"
+#include "writer3d.h"
 
 static void put(json_t *obj, const char *key, json_t *value, int *failed)
 {
@@ -70,85 +72,34 @@ json_t *gp_json_cells3d(const gp_cells3d *cells, const gp_cell3d_stats *c, int *
 /* ,"name":value (the name a literal with its quotes and colon). */
 #define field(out, name, v) (GP_OUT_LITERAL(out, name), gp_out_double(out, v))
 
-static void spheres(gp_out *out, const gp_result3d *result)
+/* The head: the document's members before the arrays, one a line (built with jansson:
+ * small), then the spheres' array opened. */
+static void head(gp_writer *w, gp_out *out, int param)
 {
-    GP_OUT_LITERAL(out, ",\n\"spheres\": [");
-    for (size_t i = 0; i < result->packing.count; i++) {
-        const gp_sphere *s = &result->packing.spheres[i];
-        if (i)
-            gp_out_char(out, ',');
-        GP_OUT_LITERAL(out, "\n{\"id\":");
-        gp_out_uint(out, i);
-        field(out, ",\"x\":", s->x);
-        field(out, ",\"y\":", s->y);
-        field(out, ",\"z\":", s->z);
-        field(out, ",\"r\":", s->r);
-        field(out, ",\"R\":", s->R);
-        if (result->has_balance) {
-            double F = result->balance.F[i]; /* defined for interior centres only */
-            if (isnan(F))
-                GP_OUT_LITERAL(out, ",\"F\":null");
-            else
-                field(out, ",\"F\":", F);
-        }
-        gp_out_char(out, '}');
-    }
-    GP_OUT_LITERAL(out, "\n]");
-}
-
-/* One object per grain: its volume, face count, the grains across its faces and the
- * walls it touches, in its faces' order. */
-static void polyhedra(gp_out *out, const gp_cells3d *c)
-{
-    GP_OUT_LITERAL(out, ",\n\"polyhedra\": [");
-    for (size_t i = 0; i < c->count; i++) {
-        if (i)
-            gp_out_char(out, ',');
-        GP_OUT_LITERAL(out, "\n{\"id\":");
-        gp_out_uint(out, i);
-        field(out, ",\"volume\":", c->volume[i]);
-        GP_OUT_LITERAL(out, ",\"faces\":");
-        gp_out_uint(out, c->fstart[i + 1] - c->fstart[i]);
-        for (int walls = 0; walls < 2; walls++) {
-            gp_out_puts(out, walls ? "],\"walls\":[" : ",\"neighbours\":[");
-            int first = 1;
-            for (size_t f = c->fstart[i]; f < c->fstart[i + 1]; f++) {
-                int32_t nb = c->fneighbour[f];
-                if (GP_IS_WALL3D(nb) != walls)
-                    continue;
-                if (!first)
-                    gp_out_char(out, ',');
-                first = 0;
-                gp_out_int(out, walls ? GP_WALL3D_INDEX(nb) : nb);
-            }
-        }
-        GP_OUT_LITERAL(out, "]}");
-    }
-    GP_OUT_LITERAL(out, "\n]");
-}
-
-int gp_write_json3d(gp_out *out, const gp_spec3d *spec, const gp_result3d *result)
-{
+    (void)param;
+    const gp_state3d *st = w->state;
+    const gp_result3d *result = st->result;
     int failed = 0;
-    json_t *head = json_object();
-    put(head, "process", json_string("pack3d"), &failed);
+    json_t *h = json_object();
+    put(h, "process", json_string("pack3d"), &failed);
     /* the same inputs as the service's validation: every stage the spec asked for */
-    put(head, "inputs", gp_spec3d_json(spec), &failed);
-    put(head, "statistics", statistics_json(spec, result, &failed), &failed);
+    put(h, "inputs", gp_spec3d_json(st->spec), &failed);
+    put(h, "statistics", statistics_json(st->spec, result, &failed), &failed);
     if (result->has_balance)
-        put(head, "balance", gp_json_balance(&result->balance, &failed), &failed);
+        put(h, "balance", gp_json_balance(&result->balance, &failed), &failed);
     if (result->has_cells)
-        put(head, "cells", gp_json_cells3d(&result->cells, &result->cell_stats, &failed), &failed);
+        put(h, "cells", gp_json_cells3d(&result->cells, &result->cell_stats, &failed), &failed);
     if (failed) {
-        json_decref(head);
-        return GP_ENOMEM;
+        json_decref(h);
+        if (!out->err)
+            out->err = GP_ENOMEM;
+        return;
     }
-    /* the head's members, then the streamed arrays, in one object */
     GP_OUT_LITERAL(out, "{");
     const char *key;
     json_t *value;
     int first = 1;
-    json_object_foreach(head, key, value) {
+    json_object_foreach(h, key, value) {
         if (!first)
             gp_out_char(out, ',');
         first = 0;
@@ -157,10 +108,99 @@ int gp_write_json3d(gp_out *out, const gp_spec3d *spec, const gp_result3d *resul
         GP_OUT_LITERAL(out, "\": ");
         gp_out_json(out, value);
     }
-    json_decref(head);
-    spheres(out, result);
-    if (result->has_cells)
-        polyhedra(out, &result->cells);
-    GP_OUT_LITERAL(out, "\n}\n");
-    return gp_out_flush(out);
+    json_decref(h);
+    GP_OUT_LITERAL(out, ",\n\"spheres\": [");
+}
+
+static void sphere(gp_writer *w, gp_out *out, size_t i, int param)
+{
+    (void)param;
+    const gp_state3d *st = w->state;
+    int balance = st->result->has_balance;
+    const gp_window3d *win = gp_state3d_window(w, out, GP_W3_SPHERES | (balance ? GP_W3_F : 0), i);
+    if (!win)
+        return;
+    const gp_sphere *s = &win->spheres[i - win->first];
+    if (i)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"id\":");
+    gp_out_uint(out, i);
+    field(out, ",\"x\":", s->x);
+    field(out, ",\"y\":", s->y);
+    field(out, ",\"z\":", s->z);
+    field(out, ",\"r\":", s->r);
+    field(out, ",\"R\":", s->R);
+    if (balance)
+        gp_out_json_F(out, win->F[i - win->first]);
+    gp_out_char(out, '}');
+}
+
+/* Closes the spheres' array (`param`: and opens the polyhedra's). */
+static void between(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    GP_OUT_LITERAL(out, "\n]");
+    if (param)
+        GP_OUT_LITERAL(out, ",\n\"polyhedra\": [");
+}
+
+/* One object per grain: its volume, face count, the grains across its faces and the
+ * walls it touches, in its faces' order. */
+static void polyhedron(gp_writer *w, gp_out *out, size_t i, int param)
+{
+    (void)param;
+    const gp_window3d *win = gp_state3d_window(w, out, GP_W3_CELLS | GP_W3_NEIGHBOURS | GP_W3_VOLUME, i);
+    if (!win)
+        return;
+    const gp_cells3d *c = win->cells;
+    size_t j = i - win->first;
+    if (i)
+        gp_out_char(out, ',');
+    GP_OUT_LITERAL(out, "\n{\"id\":");
+    gp_out_uint(out, i);
+    field(out, ",\"volume\":", c->volume[j]);
+    GP_OUT_LITERAL(out, ",\"faces\":");
+    gp_out_uint(out, c->fstart[j + 1] - c->fstart[j]);
+    for (int walls = 0; walls < 2; walls++) {
+        gp_out_puts(out, walls ? "],\"walls\":[" : ",\"neighbours\":[");
+        int first = 1;
+        for (size_t f = c->fstart[j]; f < c->fstart[j + 1]; f++) {
+            int32_t nb = c->fneighbour[f];
+            if (GP_IS_WALL3D(nb) != walls)
+                continue;
+            if (!first)
+                gp_out_char(out, ',');
+            first = 0;
+            gp_out_int(out, walls ? GP_WALL3D_INDEX(nb) : nb);
+        }
+    }
+    GP_OUT_LITERAL(out, "]}");
+}
+
+static void tail(gp_writer *w, gp_out *out, int param)
+{
+    (void)w;
+    (void)param;
+    GP_OUT_LITERAL(out, "\n]\n}\n");
+}
+
+int gp_plan_json3d(gp_writer *w, const gp_plan3d_args *a)
+{
+    int rc = gp_plan3d_state(w, a, sizeof(gp_state3d));
+    if (rc)
+        return rc;
+    size_t n = a->result->packing.count;
+    gp_writer_text(w, head, 0);
+    gp_writer_items(w, sphere, n, 0);
+    if (a->result->has_cells) {
+        gp_writer_text(w, between, 1);
+        gp_writer_items(w, polyhedron, n, 0);
+    }
+    gp_writer_text(w, tail, 0);
+    return 0;
+}
+
+int gp_write_json3d(gp_out *out, const gp_spec3d *spec, const gp_result3d *result)
+{
+    return gp_write3d_memory(out, GP_FORMAT3D_JSON, spec, result);
 }

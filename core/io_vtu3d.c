@@ -1,118 +1,172 @@
 /* io_vtu3d.c - the 3D result as a VTK XML unstructured grid (ASCII): the Laguerre
  * polyhedra as VTK_POLYHEDRON cells, or without cells the sphere centres as vertices,
- * with the grains' data on the cells. ParaView, VTK and meshio read it. */
+ * with the grains' data on the cells. ParaView, VTK and meshio read it. Written window
+ * by window (writer3d.h): each data array is one pass over the grains, carrying only a
+ * running offset from one to the next. */
 #include <math.h>
 
-#include "grainpack/io3d.h"
 #include "vtu_array.h"
+#include "writer3d.h"
 
 /* VTK cell types (vtkCellType.h). */
 #define VTK_VERTEX 1
 #define VTK_POLYHEDRON 42
 
-/* The Cells element of the polyhedra: connectivity = each cell's own vertices; "faces" =
- * per cell its face count then each face's size and point ids, "faceoffsets" = where
- * each cell's stream ends in "faces" (VTK's polyhedron layout before VTK 9.4, which 9.4
- * still reads). */
-static void polyhedra(gp_out *o, const gp_cells3d *c)
+/* The data arrays, in the order they are written. With cells: connectivity = each cell's
+ * own vertices; "faces" = per cell its face count then each face's size and point ids,
+ * "faceoffsets" = where each cell's stream ends in "faces" (VTK's polyhedron layout
+ * before VTK 9.4, which 9.4 still reads). */
+enum { POINTS, CONNECTIVITY, OFFSETS, TYPES, FACES, FACEOFFSETS, GRAIN, RADIUS, PACKING_RADIUS,
+       VOLUME, F, ARRAYS };
+static const struct {
+    const char *type, *name;
+} array[ARRAYS] = {
+    {"Float64", "Points"}, {"Int64", "connectivity"}, {"Int64", "offsets"}, {"UInt8", "types"},
+    {"Int64", "faces"},   {"Int64", "faceoffsets"},  {"Int32", "grain"},   {"Float64", "r"},
+    {"Float64", "R"},     {"Float64", "volume"},     {"Float64", "F"},
+};
+
+typedef struct vtu3d_state {
+    gp_state3d base;
+    vtu_array a;     /* the data array being written */
+    int64_t end;     /* faceoffsets: where the last cell's stream ended in "faces" */
+} vtu3d_state;
+
+/* Opens data array `param` after closing the one before it (what separates them). */
+static void open_array(gp_writer *w, gp_out *o, int param)
 {
-    vtu_array a = vtu_open_array(o, "Int64", "connectivity", 1);
-    for (size_t k = 0; k < c->vstart[c->count]; k++)
-        vtu_int(&a, (int64_t)k);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Int64", "offsets", 1);
-    for (size_t i = 0; i < c->count; i++)
-        vtu_int(&a, (int64_t)c->vstart[i + 1]);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "UInt8", "types", 1);
-    for (size_t i = 0; i < c->count; i++)
-        vtu_int(&a, VTK_POLYHEDRON);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Int64", "faces", 1);
-    for (size_t i = 0; i < c->count; i++) {
-        vtu_int(&a, (int64_t)(c->fstart[i + 1] - c->fstart[i]));
-        for (size_t f = c->fstart[i]; f < c->fstart[i + 1]; f++) {
-            vtu_int(&a, (int64_t)(c->fvstart[f + 1] - c->fvstart[f]));
-            for (size_t k = c->fvstart[f]; k < c->fvstart[f + 1]; k++)
-                vtu_int(&a, (int64_t)(c->vstart[i] + c->fverts[k]));
-        }
-    }
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Int64", "faceoffsets", 1);
-    int64_t end = 0;
-    for (size_t i = 0; i < c->count; i++) {
-        end += 1;
-        for (size_t f = c->fstart[i]; f < c->fstart[i + 1]; f++)
-            end += 1 + (int64_t)(c->fvstart[f + 1] - c->fvstart[f]);
-        vtu_int(&a, end);
-    }
-    vtu_close_array(&a);
+    vtu3d_state *st = w->state;
+    const gp_result3d *r = st->base.result;
+    if (param == POINTS)
+        vtu_header(o, r->has_cells ? r->cell_stats.vertices : r->packing.count, r->packing.count);
+    else
+        vtu_close_array(&st->a);
+    if (param == CONNECTIVITY)
+        gp_out_puts(o, "</Points>\n<Cells>\n");
+    else if (param == GRAIN)
+        gp_out_puts(o, "</Cells>\n<CellData Scalars=\"grain\">\n");
+    st->end = 0;
+    st->a = vtu_open_array(o, array[param].type, array[param].name, param == POINTS ? 3 : 1);
 }
 
-static void vertices(gp_out *o, size_t n)
+static void tail(gp_writer *w, gp_out *o, int param)
 {
-    vtu_array a = vtu_open_array(o, "Int64", "connectivity", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_int(&a, (int64_t)i);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Int64", "offsets", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_int(&a, (int64_t)i + 1);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "UInt8", "types", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_int(&a, VTK_VERTEX);
-    vtu_close_array(&a);
+    (void)param;
+    vtu3d_state *st = w->state;
+    vtu_close_array(&st->a);
+    gp_out_puts(o, "</CellData>\n");
+    int rc = vtu_footer(o);
+    if (rc && !o->err)
+        o->err = rc;
+}
+
+/* Item k's value k + param (point indices, grain ids, a vertex's offset). */
+static void index_value(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)o;
+    vtu3d_state *st = w->state;
+    vtu_int(&st->a, (int64_t)k + param);
+}
+
+/* The VTK cell type `param`, once per item. */
+static void cell_type(gp_writer *w, gp_out *o, size_t k, int param)
+{
+    (void)o;
+    (void)k;
+    vtu3d_state *st = w->state;
+    vtu_int(&st->a, param);
+}
+
+/* What each array reads of a window. */
+static unsigned needs(const gp_result3d *r, int param)
+{
+    switch (param) {
+    case POINTS: return r->has_cells ? GP_W3_CELLS | GP_W3_XYZ : GP_W3_SPHERES;
+    case OFFSETS: return GP_W3_CELLS;
+    case FACES:
+    case FACEOFFSETS: return GP_W3_CELLS | GP_W3_FACES;
+    case VOLUME: return GP_W3_CELLS | GP_W3_VOLUME;
+    case F: return GP_W3_F;
+    default: return GP_W3_SPHERES;
+    }
+}
+
+/* Grain i's values in array `param`. */
+static void grain_value(gp_writer *w, gp_out *o, size_t i, int param)
+{
+    vtu3d_state *st = w->state;
+    const gp_window3d *win = gp_state3d_window(w, o, needs(st->base.result, param), i);
+    if (!win)
+        return;
+    size_t j = i - win->first;
+    const gp_cells3d *c = win->cells;
+    vtu_array *a = &st->a;
+    switch (param) {
+    case POINTS:
+        if (!c) {
+            vtu_double(a, win->spheres[j].x);
+            vtu_double(a, win->spheres[j].y);
+            vtu_double(a, win->spheres[j].z);
+            break;
+        }
+        for (size_t k = 3 * c->vstart[j]; k < 3 * c->vstart[j + 1]; k++)
+            vtu_double(a, c->xyz[k]);
+        break;
+    case OFFSETS: vtu_int(a, (int64_t)(win->vertex_base + c->vstart[j + 1])); break;
+    case FACES:
+        vtu_int(a, (int64_t)(c->fstart[j + 1] - c->fstart[j]));
+        for (size_t f = c->fstart[j]; f < c->fstart[j + 1]; f++) {
+            vtu_int(a, (int64_t)(c->fvstart[f + 1] - c->fvstart[f]));
+            for (size_t k = c->fvstart[f]; k < c->fvstart[f + 1]; k++)
+                vtu_int(a, (int64_t)(win->vertex_base + c->vstart[j] + c->fverts[k]));
+        }
+        break;
+    case FACEOFFSETS:
+        st->end += 1;
+        for (size_t f = c->fstart[j]; f < c->fstart[j + 1]; f++)
+            st->end += 1 + (int64_t)(c->fvstart[f + 1] - c->fvstart[f]);
+        vtu_int(a, st->end);
+        break;
+    case RADIUS: vtu_double(a, win->spheres[j].r); break;
+    case PACKING_RADIUS: vtu_double(a, win->spheres[j].R); break;
+    case VOLUME: vtu_double(a, c->volume[j]); break;
+    default: vtu_double(a, isnan(win->F[j]) ? VTU_NO_QUALITY : win->F[j]); break;
+    }
+}
+
+int gp_plan_vtu3d(gp_writer *w, const gp_plan3d_args *a)
+{
+    int rc = gp_plan3d_state(w, a, sizeof(vtu3d_state));
+    if (rc)
+        return rc;
+    const gp_result3d *r = a->result;
+    size_t n = r->packing.count;
+    int cells = r->has_cells;
+    gp_writer_text(w, open_array, POINTS);
+    gp_writer_items(w, grain_value, n, POINTS);
+    gp_writer_text(w, open_array, CONNECTIVITY);
+    gp_writer_items(w, index_value, cells ? r->cell_stats.vertices : n, 0);
+    gp_writer_text(w, open_array, OFFSETS);
+    if (cells)
+        gp_writer_items(w, grain_value, n, OFFSETS);
+    else
+        gp_writer_items(w, index_value, n, 1);
+    gp_writer_text(w, open_array, TYPES);
+    gp_writer_items(w, cell_type, n, cells ? VTK_POLYHEDRON : VTK_VERTEX);
+    for (int k = cells ? FACES : GRAIN; k < ARRAYS; k++) {
+        if ((k == VOLUME && !cells) || (k == F && !r->has_balance))
+            continue;
+        gp_writer_text(w, open_array, k);
+        if (k == GRAIN)
+            gp_writer_items(w, index_value, n, 0);
+        else
+            gp_writer_items(w, grain_value, n, k);
+    }
+    gp_writer_text(w, tail, 0);
+    return 0;
 }
 
 int gp_write_vtu3d(gp_out *o, const gp_result3d *result)
 {
-    const gp_packing3d *pk = &result->packing;
-    const gp_cells3d *c = result->has_cells ? &result->cells : NULL;
-    size_t n = pk->count, points = c ? c->vstart[c->count] : n;
-    vtu_header(o, points, n);
-    vtu_array a = vtu_open_array(o, "Float64", "Points", 3);
-    for (size_t k = 0; k < points; k++) {
-        if (c) {
-            for (int d = 0; d < 3; d++)
-                vtu_double(&a, c->xyz[3 * k + (size_t)d]);
-        } else {
-            vtu_double(&a, pk->spheres[k].x);
-            vtu_double(&a, pk->spheres[k].y);
-            vtu_double(&a, pk->spheres[k].z);
-        }
-    }
-    vtu_close_array(&a);
-    gp_out_puts(o, "</Points>\n<Cells>\n");
-    if (c)
-        polyhedra(o, c);
-    else
-        vertices(o, n);
-    gp_out_puts(o, "</Cells>\n<CellData Scalars=\"grain\">\n");
-    a = vtu_open_array(o, "Int32", "grain", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_int(&a, (int64_t)i);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Float64", "r", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_double(&a, pk->spheres[i].r);
-    vtu_close_array(&a);
-    a = vtu_open_array(o, "Float64", "R", 1);
-    for (size_t i = 0; i < n; i++)
-        vtu_double(&a, pk->spheres[i].R);
-    vtu_close_array(&a);
-    if (c) {
-        a = vtu_open_array(o, "Float64", "volume", 1);
-        for (size_t i = 0; i < n; i++)
-            vtu_double(&a, c->volume[i]);
-        vtu_close_array(&a);
-    }
-    if (result->has_balance) {
-        a = vtu_open_array(o, "Float64", "F", 1);
-        for (size_t i = 0; i < n; i++)
-            vtu_double(&a, isnan(result->balance.F[i]) ? VTU_NO_QUALITY : result->balance.F[i]);
-        vtu_close_array(&a);
-    }
-    gp_out_puts(o, "</CellData>\n");
-    return vtu_footer(o);
+    return gp_write3d_memory(o, GP_FORMAT3D_VTU, NULL, result);
 }

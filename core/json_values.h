@@ -31,6 +31,10 @@ json_t *gp_distribution_stats_json(const gp_pack_stats *st);
  * statistics object, a job's status. */
 void gp_out_json(gp_out *out, const json_t *value);
 
+/* A grain's ,"F":value after balancing, null where F is undefined (NaN: centres on the
+ * boundary, balance.h), as the 2D and 3D JSON writers write it. */
+void gp_out_json_F(gp_out *out, double F);
+
 /* The spec as JSON inputs, every default made explicit (seed, joint, front, the stages'
  * options, picture): parsed again it gives the same spec. Returns a new reference the
  * caller owns, or NULL when out of memory. */

@@ -220,12 +220,20 @@ int gp_sections_from_result3d(const gp_box *box, const gp_result3d *result, cons
 int gp_section_decode_result3d(const gp_section *raw, size_t nraw, gp_box *box, gp_result3d *out,
                                size_t *tess_len);
 
-/* Reads the arrays of a stored 3D result whole (spheres, F, the polyhedra) into `result`
- * (decoded by gp_section_decode_result3d) through `read` (ctx its argument), checking
- * that the cells' counts add up to the summary's totals, that face vertices index their
- * cell's vertices and that neighbours are grains or walls. Returns 0, GP_ENOMEM, the
- * reader's code or GP_EPARSE; what it read is owned by `result`. */
-int gp_sections_read_result3d(gp_result3d *result, gp_section_read_fn read, void *ctx);
+/* Cells a window of a stored 3D result holds: about 1 KB a cell (its vertices, faces and
+ * face vertices), half a megabyte. */
+#define GP_SECTIONS_WINDOW_CELLS3D 512
+
+/* The arrays of a stored 3D result (`summary`, decoded by gp_section_decode_result3d,
+ * borrowed: it must outlive the source) for the 3D writers (writer3d.h), read through
+ * `read` (ctx is its argument) `window` grains at a time (0: GP_SECTIONS_WINDOW_CELLS3D),
+ * checked as they are read (GP_EPARSE from the writer: sizes that overrun the summary's
+ * totals, a face with more vertices than its cell, a face vertex out of its cell, a
+ * neighbour neither a grain nor a wall). Returns 0 or GP_ENOMEM; free with
+ * gp_source3d_free. */
+struct gp_source3d;
+int gp_sections_source3d(const gp_result3d *summary, gp_section_read_fn read, void *ctx,
+                         size_t window, struct gp_source3d *out);
 
 #ifdef __cplusplus
 }

@@ -116,6 +116,16 @@ gp_writer *gp_writer_new(gp_format format, const gp_spec *spec, const gp_result 
     return w;
 }
 
+gp_writer *gp_writer_new_plan(int (*plan)(gp_writer *w, void *arg), void *arg)
+{
+    gp_writer *w = calloc(1, sizeof *w);
+    if (w && (plan(w, arg) || w->overflow)) {
+        gp_writer_free(w);
+        return NULL;
+    }
+    return w;
+}
+
 void gp_writer_free(gp_writer *w)
 {
     if (!w)

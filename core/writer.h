@@ -62,6 +62,12 @@ void gp_writer_items(gp_writer *w, gp_item_fn fn, size_t count, int param);
  * the same array. NULL when the source fails: out->err is then set. */
 const void *gp_writer_mesh(gp_writer *w, gp_out *out, gp_mesh_array a, size_t k);
 
+/* A writer whose steps `plan` adds (with `arg`): the formats of another process than
+ * the 2D result's (the 3D writers, writer3d.h), run by gp_writer_run like the 2D ones.
+ * Its format, spec and result are unset: the plan's state holds what it writes from.
+ * Returns NULL when out of memory or when the plan fails. Free with gp_writer_free. */
+gp_writer *gp_writer_new_plan(int (*plan)(gp_writer *w, void *arg), void *arg);
+
 /* Each format's plan: adds its steps, sets up its state. Returns 0 or GP_ENOMEM. */
 int gp_plan_csv(gp_writer *w);
 int gp_plan_json(gp_writer *w);

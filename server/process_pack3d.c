@@ -3,7 +3,6 @@
  * spec asks (gp_pipeline3d_run), stored as sections (sections.h) with the .tess text the
  * worker renders, and served from them as CSV, JSON, VTU, tess or the section's SVG. */
 #include <jansson.h>
-#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,14 +19,8 @@
 #include "problem.h"
 #include "processes.h"
 #include "render.h"
-
-/* Spheres read from the store at once when a download renders them: 40 KB a window, the
- * order of the text it makes (some 60 bytes a sphere) and of a store chunk. */
-#define WINDOW_SPHERES 1024
-
-/* A whole-rendered download at least this large gives its pages back to the system when
- * it ends (malloc_trim, a few ms): below, what glibc keeps mapped is not worth the call. */
-#define WHOLE_TRIM_BYTES ((size_t)16 << 20)
+#include "sections.h"
+#include "writer3d.h"
 
 static int parse(const char *text, size_t len, const gp_spec_limits *limits, void **out,
                  gp_error *err)
@@ -198,7 +191,7 @@ static int stored_summary(const gp_stored_result *res, stored3d *out)
  * the spheres' densities (volume fractions), radii and joints, the law's bins and how the
  * front went; then (not in the JSON download's "statistics", which has them beside it)
  * "balance" and "cells" when they ran. NULL when out of memory. */
-static json_t *summary_json(const gp_result3d *r, uint64_t seed, int stages)
+static json_t *summary_json(const gp_result3d *r, uint64_t seed)
 {
     const gp_pack3d_stats *st = &r->stats;
     const gp_packing3d *pk = &r->packing;
@@ -214,10 +207,10 @@ static json_t *summary_json(const gp_result3d *r, uint64_t seed, int stages)
                           (json_int_t)pk->triangles, "attempts", (json_int_t)pk->attempts,
                           "max_level", (json_int_t)pk->max_level, "seed", (json_int_t)seed);
     int failed = !o;
-    if (o && stages && r->has_balance &&
+    if (o && r->has_balance &&
         json_object_set_new(o, "balance", gp_json_balance(&r->balance, &failed)))
         failed = 1;
-    if (o && stages && r->has_cells &&
+    if (o && r->has_cells &&
         json_object_set_new(o, "cells", gp_json_cells3d(&r->cells, &r->cell_stats, &failed)))
         failed = 1;
     if (failed) {
@@ -235,9 +228,8 @@ static int stored_spec(const gp_stored_result *res, gp_spec3d *spec)
     return gp_spec3d_parse(res->spec_text, res->spec_len, &unlimited, spec, &err);
 }
 
-/* The statistics of a stored result (with its stages' when `stages`), and its inputs
- * when `inputs` is not NULL. */
-static json_t *stored_statistics(const gp_stored_result *res, int stages, json_t **inputs)
+/* The statistics of a stored result, with its stages' ("balance", "cells"). */
+static json_t *statistics(const gp_stored_result *res)
 {
     gp_spec3d spec;
     stored3d sum;
@@ -245,124 +237,11 @@ static json_t *stored_statistics(const gp_stored_result *res, int stages, json_t
         return NULL;
     json_t *stats = NULL;
     if (stored_summary(res, &sum) == 0) {
-        stats = summary_json(&sum.result, spec.seed, stages);
+        stats = summary_json(&sum.result, spec.seed);
         gp_result3d_free(&sum.result);
-    }
-    if (stats && inputs && !(*inputs = gp_spec3d_json(&spec))) {
-        json_decref(stats);
-        stats = NULL;
     }
     gp_spec3d_free(&spec);
     return stats;
-}
-
-static json_t *statistics(const gp_stored_result *res)
-{
-    return stored_statistics(res, 1, NULL);
-}
-
-/* A download of the spheres: CSV rows, or the JSON document's "spheres" array after its
- * head (the inputs and statistics). */
-typedef struct spheres_text {
-    gp_format format;
-    size_t count, next; /* spheres in all, and the next to write */
-    json_t *inputs, *stats; /* JSON: written first, then dropped */
-    int started, done;
-    gp_sphere window[WINDOW_SPHERES];
-} spheres_text;
-
-static void spheres_text_free(void *ctx)
-{
-    spheres_text *t = ctx;
-    json_decref(t->inputs);
-    json_decref(t->stats);
-    free(t);
-}
-
-static void write_head(spheres_text *t, gp_out *text)
-{
-    if (t->format == GP_FORMAT_CSV) {
-        gp_out_puts(text, "x,y,z,r,R\n");
-        return;
-    }
-    /* as gp_write_json3d: the head's members one a line, then the spheres */
-    GP_OUT_LITERAL(text, "{\n\"process\": \"pack3d\",\n\"inputs\": ");
-    gp_out_json(text, t->inputs);
-    GP_OUT_LITERAL(text, ",\n\"statistics\": ");
-    gp_out_json(text, t->stats);
-    GP_OUT_LITERAL(text, ",\n\"spheres\": [");
-}
-
-/* One sphere: "x,y,z,r,R\n" in CSV (as gp_write_spheres_csv), {"id", "x", "y", "z", "r",
- * "R"} in JSON (as gp_write_json3d); the shortest decimals that read back exactly. */
-static void write_sphere(const spheres_text *t, gp_out *text, size_t i, const gp_sphere *s)
-{
-    const double v[5] = {s->x, s->y, s->z, s->r, s->R};
-    static const char *const json_names[5] = {",\"x\":", ",\"y\":", ",\"z\":", ",\"r\":",
-                                              ",\"R\":"};
-    int json = t->format == GP_FORMAT_JSON;
-    if (json) {
-        gp_out_puts(text, i ? ",\n{\"id\":" : "\n{\"id\":");
-        gp_out_uint(text, i);
-    }
-    for (int k = 0; k < 5; k++) {
-        if (json)
-            gp_out_puts(text, json_names[k]);
-        else if (k)
-            gp_out_char(text, ',');
-        gp_out_double(text, v[k]);
-    }
-    gp_out_char(text, json ? '}' : '\n');
-}
-
-static int spheres_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text,
-                       size_t want)
-{
-    spheres_text *t = ctx;
-    if (!t->started) {
-        write_head(t, text);
-        t->started = 1;
-    }
-    while (t->next < t->count && text->len < want) {
-        size_t n = t->count - t->next < WINDOW_SPHERES ? t->count - t->next : WINDOW_SPHERES;
-        int rc = read(read_ctx, GP_SECTION_SPHERES, (uint64_t)t->next * sizeof(gp_sphere),
-                      t->window, n * sizeof(gp_sphere));
-        if (rc)
-            return rc;
-        for (size_t i = 0; i < n; i++)
-            write_sphere(t, text, t->next + i, &t->window[i]);
-        t->next += n;
-    }
-    if (t->next == t->count && !t->done) {
-        if (t->format == GP_FORMAT_JSON)
-            GP_OUT_LITERAL(text, "\n]\n}\n");
-        t->done = 1;
-    }
-    return t->done ? 0 : 1;
-}
-
-/* The renderer of res's spheres in format (CSV, or JSON of a job that only packed). Returns 0, GP_ENOMEM or the decoder's code. */
-static int spheres_renderer(const gp_stored_result *res, gp_format format,
-                            gp_download_renderer *out)
-{
-    spheres_text *t = calloc(1, sizeof *t);
-    if (!t)
-        return GP_ENOMEM;
-    t->format = format;
-    stored3d sum;
-    int rc = stored_summary(res, &sum);
-    if (rc) {
-        free(t);
-        return rc;
-    }
-    t->count = sum.result.packing.count;
-    gp_result3d_free(&sum.result);
-    if (format == GP_FORMAT_JSON && !(t->stats = stored_statistics(res, 0, &t->inputs))) {
-        spheres_text_free(t);
-        return GP_ENOMEM;
-    }
-    *out = (gp_download_renderer){t, spheres_run, spheres_text_free};
-    return 0;
 }
 
 /* A download of the stored .tess text, copied window by window. */
@@ -385,55 +264,40 @@ static int tess_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *
     return t->next < t->len;
 }
 
-/* A download rendered whole by the command line's writer (gp_write_result3d) from the
- * arrays read whole: the polyhedra's formats, whose vertices a writer reaches from every
- * part of its output (vtu's connectivity then faces, the picture's cut of every cell),
- * and a balanced or tessellated job's JSON. Holds the result, then its text, at once
- * (docs/3d.md §10 measures it). */
-typedef struct whole_text {
+/* A download in csv, json, vtu or svg: the command line's own 3D writer (writer3d.h,
+ * the bytes of `grainpack run -f FORMAT`) reading the stored arrays window by window
+ * (gp_sections_source3d): the download holds a window of cells and the text of a batch,
+ * whatever the job's size (docs/3d.md §10). */
+typedef struct windowed_text {
     gp_spec3d spec;
-    gp_result3d result; /* the summary, then the arrays: dropped once rendered */
+    gp_result3d summary; /* counts and statistics, arrays NULL */
     gp_format3d format;
-    gp_out out;         /* memory mode: the whole text */
-    size_t pos;         /* bytes of it handed on */
-    int rendered;
-} whole_text;
+    gp_source3d source;
+    gp_writer *writer;   /* made at the first run, when the reader is known */
+} windowed_text;
 
-static void whole_text_free(void *ctx)
+static void windowed_text_free(void *ctx)
 {
-    whole_text *t = ctx;
-    int large = t->out.cap >= WHOLE_TRIM_BYTES;
+    windowed_text *t = ctx;
+    gp_writer_free(t->writer);
+    gp_source3d_free(&t->source);
     gp_spec3d_free(&t->spec);
-    gp_result3d_free(&t->result);
-    gp_out_free(&t->out);
+    gp_result3d_free(&t->summary);
     free(t);
-    /* the arrays and the text went back to malloc's arenas, which glibc keeps mapped (an
-       80 000-sphere VTU left the daemon 135 MB larger, docs/3d.md §10): give them back */
-    if (large)
-        malloc_trim(0);
 }
 
-static int whole_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text, size_t want)
+static int windowed_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out *text,
+                        size_t want)
 {
-    whole_text *t = ctx;
-    if (!t->rendered) {
-        int rc = gp_sections_read_result3d(&t->result, read, read_ctx);
+    windowed_text *t = ctx;
+    if (!t->writer) {
+        int rc = gp_sections_source3d(&t->summary, read, read_ctx, 0, &t->source);
         if (rc)
             return rc;
-        if (gp_out_init(&t->out, 0, NULL, NULL))
+        if (!(t->writer = gp_writer3d_new(t->format, &t->spec, &t->summary, &t->source)))
             return GP_ENOMEM;
-        gp_error err = {0};
-        rc = gp_write_result3d(&t->out, t->format, &t->spec, &t->result, &err);
-        gp_result3d_free(&t->result);
-        if (rc)
-            return rc;
-        t->rendered = 1;
     }
-    size_t room = want > text->len ? want - text->len : 0, left = t->out.len - t->pos;
-    size_t n = left < room ? left : room;
-    gp_out_write(text, t->out.buf + t->pos, n);
-    t->pos += n;
-    return t->pos < t->out.len;
+    return gp_writer_run(t->writer, text, want);
 }
 
 /* The renderer of res in `format` (its summary decoded in `sum`, taken over). Returns 0,
@@ -441,12 +305,6 @@ static int whole_run(void *ctx, gp_section_read_fn read, void *read_ctx, gp_out 
 static int renderer_of(const gp_stored_result *res, stored3d *sum, gp_format format,
                        gp_download_renderer *out)
 {
-    const gp_result3d *r = &sum->result;
-    if (format == GP_FORMAT_CSV ||
-        (format == GP_FORMAT_JSON && !r->has_balance && !r->has_cells)) {
-        gp_result3d_free(&sum->result);
-        return spheres_renderer(res, format, out);
-    }
     if (format == GP_FORMAT_TESS) {
         tess_text *t = calloc(1, sizeof *t);
         gp_result3d_free(&sum->result);
@@ -456,23 +314,24 @@ static int renderer_of(const gp_stored_result *res, stored3d *sum, gp_format for
         *out = (gp_download_renderer){t, tess_run, free};
         return 0;
     }
-    whole_text *t = calloc(1, sizeof *t);
+    windowed_text *t = calloc(1, sizeof *t);
     if (!t) {
         gp_result3d_free(&sum->result);
         return GP_ENOMEM;
     }
-    t->result = sum->result;
+    t->summary = sum->result;
     memset(&sum->result, 0, sizeof sum->result);
     t->format = format == GP_FORMAT_JSON  ? GP_FORMAT3D_JSON
+                : format == GP_FORMAT_CSV ? GP_FORMAT3D_CSV
                 : format == GP_FORMAT_VTU ? GP_FORMAT3D_VTU
                                           : GP_FORMAT3D_SVG;
     int rc = stored_spec(res, &t->spec);
     if (rc) {
-        gp_result3d_free(&t->result);
+        gp_result3d_free(&t->summary);
         free(t);
         return rc;
     }
-    *out = (gp_download_renderer){t, whole_run, whole_text_free};
+    *out = (gp_download_renderer){t, windowed_run, windowed_text_free};
     return 0;
 }
 

@@ -4,7 +4,7 @@
  * grains, so that every cell boundary falls on one), and when it is stopped and resumed
  * every few bytes. Corrupt or truncated sections are refused, not read past. A 3D
  * packing's sections read back the same way, and a balanced, tessellated 3D result's give
- * every 3D writer its bytes in memory. */
+ * every 3D writer its bytes in memory, read window by window too. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -14,6 +14,7 @@
 #include "json_values.h"
 #include "sections.h"
 #include "mesh_source.h"
+#include "writer3d.h"
 #include "packing_checks.h"
 #include "render_checks.h"
 
@@ -509,10 +510,38 @@ static char *render3d(gp_format3d format, const gp_spec3d *spec, const gp_result
     return o.buf; /* the caller frees it */
 }
 
+/* The text of the stored result (`summary` decoded, the arrays in `st`) in `format`,
+ * read `window` cells at a time, each gp_writer_run asked for `step` more bytes (1: it
+ * stops after every grain, at least once a grain); *len its length, *rc the writer's
+ * last code. */
+static char *render_stored3d(gp_format3d format, const gp_spec3d *spec, const gp_result3d *summary,
+                           stored *st, size_t window, size_t step, size_t *len, int *rc)
+{
+    gp_source3d source;
+    CHECK(gp_sections_source3d(summary, read_stored, st, window, &source) == 0);
+    gp_writer *w = gp_writer3d_new(format, spec, summary, &source);
+    CHECK(w != NULL);
+    gp_out o;
+    CHECK(gp_out_init(&o, 0, NULL, NULL) == 0);
+    size_t calls = 0;
+    while ((*rc = gp_writer_run(w, &o, step > SIZE_MAX - o.len ? SIZE_MAX : o.len + step)) == 1)
+        calls++;
+    /* (the svg writes nothing for a grain the section misses) */
+    CHECK_MSG(step != 1 || *rc || format == GP_FORMAT3D_SVG || calls >= summary->packing.count,
+              "%s: %zu stops for %zu grains",
+              gp_format3d_name(format), calls, summary->packing.count);
+    gp_writer_free(w);
+    gp_source3d_free(&source);
+    *len = o.len;
+    return o.buf; /* the caller frees it */
+}
+
 /* A balanced, tessellated 3D result cut into sections, the summary decoded and the
- * arrays read back: every format writes the same bytes from them as from the result in
- * memory, the stored .tess is the text it was given, and a face vertex or neighbour out
- * of range, truncated sizes or a truncated summary are refused. */
+ * arrays read window by window: every format writes the same bytes from them as from the
+ * result in memory, whatever the window (one cell, a few, the default) and however little
+ * each call may write; the stored .tess is the text it was given; a summary without its
+ * arrays is refused by the writers; a face vertex or neighbour out of range, sizes that
+ * overrun the totals, a face larger than its cell or a truncated summary are refused. */
 static void test_result3d_sections(void)
 {
     gp_spec3d spec;
@@ -547,41 +576,63 @@ static void test_result3d_sections(void)
           !back.cells.vstart && back.cell_stats.faces == r.cell_stats.faces &&
           back.balance.after.max == r.balance.after.max && back.balance.sweeps == r.balance.sweeps);
     CHECK(memcmp(&box, &spec.box, sizeof box) == 0);
-    CHECK(gp_sections_read_result3d(&back, read_stored, &st) == 0);
     const gp_format3d formats[] = {GP_FORMAT3D_CSV, GP_FORMAT3D_JSON, GP_FORMAT3D_VTU, GP_FORMAT3D_SVG};
     for (size_t k = 0; k < sizeof formats / sizeof formats[0]; k++) {
-        size_t a, b;
+        size_t a;
         char *want = render3d(formats[k], &spec, &r, &a);
-        char *got = render3d(formats[k], &spec, &back, &b);
-        CHECK_MSG(a == b && memcmp(want, got, a) == 0, "%s: %zu bytes from the sections, %zu in memory",
-                  gp_format3d_name(formats[k]), b, a);
+        /* the summary alone: refused, not read through NULL */
+        gp_out o;
+        CHECK(gp_out_init(&o, 0, NULL, NULL) == 0);
+        CHECK_MSG(gp_write_result3d(&o, formats[k], &spec, &back, &err) == GP_EINVAL, "%s of a summary",
+                  gp_format3d_name(formats[k]));
+        gp_out_free(&o);
+        const size_t windows[] = {1, 3, 0}, steps[] = {1, 700, SIZE_MAX};
+        for (size_t v = 0; v < 3; v++) {
+            size_t b;
+            int rc;
+            char *got = render_stored3d(formats[k], &spec, &back, &st, windows[v], steps[v], &b, &rc);
+            CHECK_MSG(rc == 0 && a == b && memcmp(want, got, a) == 0,
+                      "%s: %zu bytes from the sections (window %zu), %zu in memory",
+                      gp_format3d_name(formats[k]), b, windows[v], a);
+            free(got);
+        }
         free(want);
-        free(got);
     }
     char *tess_back = malloc(tess_len);
     CHECK(read_stored(&st, GP_SECTION_TESS, 0, tess_back, tess_len) == 0 &&
           memcmp(tess_back, tess, tess_len) == 0);
     free(tess_back);
-    gp_result3d_free(&back);
 
-    /* corrupt arrays: each read is refused, not indexed past */
-    for (int corruption = 0; corruption < 3; corruption++) {
-        stored bad;
-        store_sections(&bad, sec, n);
-        for (size_t i = 0; i < n; i++) {
-            if (corruption == 0 && strcmp(sec[i].tag, GP_SECTION_CELL3D_FACE_VERTICES) == 0)
-                ((uint32_t *)bad.copy[i])[0] = 1000000;
-            if (corruption == 1 && strcmp(sec[i].tag, GP_SECTION_CELL3D_FACE_NEIGHBOURS) == 0)
-                ((int32_t *)bad.copy[i])[0] = (int32_t)r.packing.count;
-            if (corruption == 2 && strcmp(sec[i].tag, GP_SECTION_CELL3D_SIZES) == 0)
-                ((uint32_t *)bad.copy[i])[0] += 1;
+    /* corrupt arrays: each window is refused, not indexed past (the face vertices by the
+     * formats that read them, vtu and svg; the neighbours by json; the sizes by all) */
+    const struct {
+        const char *tag;
+        size_t at;
+        uint32_t value;
+        gp_format3d format;
+    } corruptions[] = {
+        {GP_SECTION_CELL3D_FACE_VERTICES, 0, 1000000, GP_FORMAT3D_VTU},
+        {GP_SECTION_CELL3D_FACE_VERTICES, 0, 1000000, GP_FORMAT3D_SVG},
+        {GP_SECTION_CELL3D_FACE_NEIGHBOURS, 0, (uint32_t)r.packing.count, GP_FORMAT3D_JSON},
+        {GP_SECTION_CELL3D_SIZES, 0, 1000000, GP_FORMAT3D_VTU},  /* cell 0's vertices */
+        {GP_SECTION_CELL3D_SIZES, 1, 1000000, GP_FORMAT3D_JSON}, /* cell 0's faces */
+        {GP_SECTION_CELL3D_FACE_SIZES, 0, 1000, GP_FORMAT3D_SVG},
+    };
+    for (size_t k = 0; k < sizeof corruptions / sizeof corruptions[0]; k++)
+        for (size_t v = 0; v < 2; v++) {
+            stored bad;
+            store_sections(&bad, sec, n);
+            for (size_t i = 0; i < n; i++)
+                if (strcmp(sec[i].tag, corruptions[k].tag) == 0)
+                    ((uint32_t *)bad.copy[i])[corruptions[k].at] = corruptions[k].value;
+            size_t b;
+            int rc;
+            free(render_stored3d(corruptions[k].format, &spec, &back, &bad, v ? 3 : 0, SIZE_MAX, &b, &rc));
+            CHECK_MSG(rc == GP_EPARSE, "corruption %zu of %s (window %d): %d", k, corruptions[k].tag,
+                      v ? 3 : 0, rc);
+            unstore_copies(&bad);
         }
-        CHECK(gp_section_decode_result3d(raw, nraw, &box, &back, &stored_tess) == 0);
-        CHECK_MSG(gp_sections_read_result3d(&back, read_stored, &bad) == GP_EPARSE, "corruption %d",
-                  corruption);
-        gp_result3d_free(&back);
-        unstore_copies(&bad);
-    }
+    gp_result3d_free(&back);
     /* every truncation of the summaries is refused */
     size_t refused = 0, cuts = 0;
     for (size_t i = 0; i < nraw; i++) {

@@ -1,7 +1,8 @@
 /* io3d.h - writers for a 3D job's result (docs/3d.md §8): CSV (pack3d.h), JSON (inputs,
  * statistics, spheres, polyhedra), VTK XML unstructured grid with polyhedral cells, Neper's
  * tessellation (.tess) and an SVG picture of a section. Each writes the whole result
- * from memory into a gp_out and flushes it; the same result gives the same bytes. */
+ * from memory into a gp_out and flushes it; the same result gives the same bytes (the
+ * service runs the same writers window by window over its stored arrays). */
 #ifndef GRAINPACK_IO3D_H
 #define GRAINPACK_IO3D_H
 

@@ -8,7 +8,8 @@ tests/tess_reader.py (Neper's documented format: a valid tessellation of the box
 polyhedron per sphere, volumes summing to the box), the SVG by Python's XML parser, the
 JSON by Python's json. /statistics holds the balancing (F_max not risen) and the cells'
 statistics, consistent with the JSON download's; gzip and If-None-Match work on the new
-formats; a job that only packed refuses f=tess with 400; bad balance and shrink blocks
+formats; a job of more cells than three of the store's windows is served byte for byte
+as the command line writes it too; a job that only packed refuses f=tess with 400; bad balance and shrink blocks
 are 422 with their JSON pointers. Responses are checked against openapi.yaml.
 Usage: test_service_pack3d_cells.py GRAINPACKD GRAINPACK"""
 
@@ -165,6 +166,37 @@ def check_statistics(c, api, client, job):
     return st
 
 
+# Cells a download reads from the store at once (GP_SECTIONS_WINDOW_CELLS3D, core/sections.h).
+WINDOW_CELLS = 512
+
+
+def check_windows(c, client, cli, tmp):
+    """A job of some 1 500 offset polyhedra (no balancing: a fraction of a second), more
+    than two of the store's windows: each download, rendered window by window, is byte for
+    byte what `grainpack run` writes, gzip too."""
+    spec = spec3d(domain={"width": 18, "height": 16, "depth": 12}, seed=5,
+                  picture={"section": {"axis": "z", "at": 0.5}})
+    del spec["inputs"]["balance"]
+    job = client.submit(spec, "pack3d").json()["jobID"]
+    if not c.check(client.wait_final(job)["status"] == "successful", "the job of several windows"):
+        return
+    n = client.get(f"/jobs/{job}/statistics").json()["count"]
+    c.check(n > 2 * WINDOW_CELLS, f"{n} spheres: not three windows of {WINDOW_CELLS}")
+    spec_path = os.path.join(tmp, "windows.json")
+    with open(spec_path, "w") as f:
+        json.dump(spec, f)
+    for fmt in ("json", "csv", "vtu", "svg"):
+        r = client.get(f"/jobs/{job}/results?f={fmt}")
+        made = subprocess.run([cli, "run", spec_path, "-f", fmt], capture_output=True, check=True).stdout
+        c.check(r.status == 200 and r.body == made,
+                f"{fmt} of {n} spheres: the download ({len(r.body)} bytes) is not what grainpack run "
+                f"writes ({len(made)} bytes)")
+        if fmt == "vtu":
+            z = client.get(f"/jobs/{job}/results?f={fmt}", headers={"Accept-Encoding": "gzip"})
+            c.check(z.headers.get("content-encoding") == "gzip" and gzip.decompress(z.body) == made,
+                    f"the gzip {fmt} of {n} spheres is not the plain one")
+
+
 def result_links(info):
     """The formats a job's status links its results in."""
     rel = "http://www.opengis.net/def/rel/ogc/1.0/results"
@@ -193,6 +225,8 @@ def test(c, binary, cli):
             st = check_statistics(c, api, client, job)
             with tempfile.TemporaryDirectory() as tmp:
                 check_downloads(c, api, client, cli, job, st, tmp)
+        with tempfile.TemporaryDirectory() as tmp:
+            check_windows(c, client, cli, tmp)
         # a job that only packed has no tessellation
         plain_spec = {"inputs": {k: v for k, v in spec3d()["inputs"].items() if k not in ("balance", "laguerre")}}
         plain = client.submit(plain_spec, "pack3d").json()["jobID"]
