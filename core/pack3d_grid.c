@@ -56,10 +56,7 @@ static inline int32_t cell_of(const p3_grid *grid, int a, double v)
     double c = v * grid->inv[a];
     if (!(c >= 0.0))
         return 0;
-    /* truncation is floor here; c is at most a cell or two past the grid (a position near
-     * the box plus a reach), far inside int32, so the clamp is done on the integer */
-    int32_t i = (int32_t)c;
-    return i < grid->n[a] ? i : grid->n[a] - 1;
+    return c >= grid->n[a] ? grid->n[a] - 1 : (int32_t)c; /* truncation is floor here */
 }
 
 static inline size_t cell_index(const p3_grid *grid, int32_t i, int32_t j, int32_t k)
