@@ -3,7 +3,7 @@
  * and the rate and memory at 10^5 and 10^6 spheres of one radius. --fingerprint prints
  * instead a hash of the reference packings' spheres (a pure speed change must leave them
  * to the bit), --case LAW packs one small box of a law alone (for callgrind's instruction
- * counts: one, bagi or iron).
+ * counts: one, bagi or iron; million: the 10^6 packing of one radius of --fingerprint).
  * Usage: grainpack_pack3d_bench [--seeds N] [--max-spheres N] [--fingerprint] [--case LAW]
  *        [EXAMPLES_DIR] */
 #include <math.h>
@@ -82,6 +82,13 @@ static void law_row(const char *name, const gp_distribution *dist, double side, 
     }
 }
 
+/* The side of the cube of the scaling rows (and of the 10^6 fingerprint): one radius 0.5,
+ * `target` spheres at a density of ~0.62. */
+static double scaling_side(double target)
+{
+    return cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.62);
+}
+
 /* Runs in a child process of its own, forked before any other packing (so that no freed
  * heap of the parent's is reused unseen), with the peak resident set reset first. */
 static void scaling_row(const gp_distribution *dist, double target)
@@ -97,8 +104,7 @@ static void scaling_row(const gp_distribution *dist, double target)
         waitpid(pid, &status, 0);
         return;
     }
-    /* one radius 0.5: a box holding `target` spheres at a density of ~0.62 */
-    double side = cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.62);
+    double side = scaling_side(target);
     gp_box box = {side, side, side};
     double before = peak_rss(1);
     gp_packing3d out;
@@ -176,8 +182,10 @@ int main(int argc, char **argv)
             fingerprint_row("3D Bagi", &bagi, 12 * 0.84, 1, GP_PACK3D_LEVEL);
         else if (!strcmp(one_case, "iron"))
             fingerprint_row("iron", &iron.dist, 10 * 16.0, 1, GP_PACK3D_LEVEL);
+        else if (!strcmp(one_case, "million"))
+            fingerprint_row("one radius 0.5, 10^6", &one, scaling_side(1e6), 1, GP_PACK3D_LEVEL);
         else {
-            fprintf(stderr, "unknown case %s (one, bagi or iron)\n", one_case);
+            fprintf(stderr, "unknown case %s (one, bagi, iron or million)\n", one_case);
             return 2;
         }
         gp_spec_free(&iron);
@@ -192,8 +200,7 @@ int main(int argc, char **argv)
                 fingerprint_row("iron", &iron.dist, 20 * 16.0, (uint64_t)s, (gp_pack3d_order)o);
         }
         if (max_spheres >= 1e6)
-            fingerprint_row("one radius 0.5, 10^6", &one, cbrt(1e6 * (4.0 / 3.0 * M_PI * 0.125) / 0.62), 1,
-                            GP_PACK3D_LEVEL);
+            fingerprint_row("one radius 0.5, 10^6", &one, scaling_side(1e6), 1, GP_PACK3D_LEVEL);
         gp_spec_free(&iron);
         return 0;
     }

@@ -89,13 +89,19 @@ int p3_overlap(double ax, double ay, double az, double aR, const gp_sphere *b)
 }
 
 /* The first sphere of the cell list from `s` on that overlaps the ball (x, y, z, R), or
- * P3_NONE. */
+ * P3_NONE. reach2 is the square of the largest overlap distance, (R + R_max) (1 -
+ * GP_CONTACT_RTOL): a sphere at least that far is not tested further (rounding is
+ * monotone, so p3_overlap would say no), which spares the sum of radii most spheres of a
+ * spread law would cost, and with one radius every sphere nearer overlaps. */
 static inline int32_t list_first_overlap(const p3_grid *grid, const gp_sphere *spheres, int32_t s,
-                                         double x, double y, double z, double R)
+                                         double x, double y, double z, double R, double reach2)
 {
-    for (; s != P3_NONE; s = grid->next[s])
-        if (p3_overlap(x, y, z, R, &spheres[s]))
+    for (; s != P3_NONE; s = grid->next[s]) {
+        const gp_sphere *b = &spheres[s];
+        double dx = x - b->x, dy = y - b->y, dz = z - b->z;
+        if (dx * dx + dy * dy + dz * dz < reach2 && p3_overlap(x, y, z, R, b))
             return s;
+    }
     return P3_NONE;
 }
 
@@ -106,7 +112,8 @@ int32_t p3_grid_first_overlap(const p3_grid *grid, const gp_sphere *spheres, dou
                               double z, double R, double R_max)
 {
     size_t home = cell_index(grid, cell_of(grid, 0, x), cell_of(grid, 1, y), cell_of(grid, 2, z));
-    int32_t s = list_first_overlap(grid, spheres, grid->head[home], x, y, z, R);
+    double reach = (R + R_max) * (1.0 - GP_CONTACT_RTOL), reach2 = reach * reach;
+    int32_t s = list_first_overlap(grid, spheres, grid->head[home], x, y, z, R, reach2);
     if (s != P3_NONE)
         return s;
     int32_t lo[3], hi[3];
@@ -116,7 +123,7 @@ int32_t p3_grid_first_overlap(const p3_grid *grid, const gp_sphere *spheres, dou
             const int32_t *row = p3_grid_row(grid, j, k);
             for (int32_t i = lo[0]; i <= hi[0]; i++)
                 if (row + i != grid->head + home &&
-                    (s = list_first_overlap(grid, spheres, row[i], x, y, z, R)) != P3_NONE)
+                    (s = list_first_overlap(grid, spheres, row[i], x, y, z, R, reach2)) != P3_NONE)
                     return s;
         }
     return P3_NONE;

@@ -62,6 +62,9 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
     double query = s->R + pk->R_max + pk->gap * pk->R_max;
     int32_t lo[3], hi[3];
     p3_grid_range(grid, s->x, s->y, s->z, query, lo, hi);
+    /* every link's reach is within the query's (rounding is monotone), and four spheres
+     * in five of the range are beyond it: they are turned away before their own reach */
+    double query2 = query * query;
     int n = 0;
     for (int32_t k = lo[2]; k <= hi[2]; k++) {
         for (int32_t j = lo[1]; j <= hi[1]; j++) {
@@ -69,7 +72,10 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
             for (int32_t i = lo[0]; i <= hi[0]; i++) {
                 for (int32_t q = row[i]; q != P3_NONE; q = grid->next[q]) {
                     const gp_sphere *o = &pk->spheres[q];
-                    double d2 = dist2(s->x, s->y, s->z, o->x, o->y, o->z), reach = link_reach(pk, s->R, o->R);
+                    double d2 = dist2(s->x, s->y, s->z, o->x, o->y, o->z);
+                    if (!(d2 < query2))
+                        continue;
+                    double reach = link_reach(pk, s->R, o->R);
                     if (d2 < reach * reach && q != c) {
                         link l = {q, sqrt(d2) - s->R - o->R, o->x, o->y, o->z, o->R};
                         n = keep_nearest(links, n, &l);
