@@ -30,7 +30,7 @@ static void pack(const gp_box *box, const gp_distribution *dist, const gp_joint 
 static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, double target)
 {
     double side = cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.6);
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, 0};
     gp_packing3d pk;
     double c0 = cpu();
     pack(&box, one, joint, &pk);
@@ -62,7 +62,7 @@ static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, dou
 
 static void balance_row(const char *name, const gp_spec *spec, double side, gp_balance_method method)
 {
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, 0};
     gp_packing3d pk;
     pack(&box, &spec->dist, &spec->joint, &pk);
     gp_rt3 *rt;
