@@ -19,16 +19,7 @@ static const char *const AXES[] = {"x", "y", "z"};
 static json_t *inputs_json(const gp_spec3d *spec, int *failed)
 {
     json_t *in = json_object();
-    json_t *domain = json_pack("{s:f, s:f, s:f}", "width", spec->box.width, "height", spec->box.height,
-                               "depth", spec->box.depth);
-    if (spec->box.periodic) {
-        json_t *axes = json_array();
-        for (int a = 0; a < 3; a++)
-            if ((spec->box.periodic >> a) & 1u && (!axes || json_array_append_new(axes, json_string(AXES[a]))))
-                *failed = 1;
-        put(domain, "periodic", axes, failed);
-    }
-    put(in, "domain", domain, failed);
+    put(in, "domain", gp_json_box(&spec->box, failed), failed);
     put(in, "distribution", gp_json_distribution(&spec->dist, failed), failed);
     put(in, "joint", gp_json_joint(&spec->joint, failed), failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), failed);
