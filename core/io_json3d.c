@@ -14,20 +14,6 @@ static void put(json_t *obj, const char *key, json_t *value, int *failed)
     }
 }
 
-static const char *const AXES[] = {"x", "y", "z"};
-
-static json_t *inputs_json(const gp_spec3d *spec, int *failed)
-{
-    json_t *in = json_object();
-    put(in, "domain", gp_json_box(&spec->box, failed), failed);
-    put(in, "distribution", gp_json_distribution(&spec->dist, failed), failed);
-    put(in, "joint", gp_json_joint(&spec->joint, failed), failed);
-    put(in, "seed", json_integer((json_int_t)spec->seed), failed);
-    put(in, "picture", json_pack("{s:{s:s, s:f}}", "section", "axis", AXES[spec->section.axis], "at",
-                                 spec->section.at), failed);
-    return in;
-}
-
 static json_t *statistics_json(const gp_spec3d *spec, const gp_result3d *result, int *failed)
 {
     const gp_pack3d_stats *st = &result->stats;
@@ -146,7 +132,8 @@ int gp_write_json3d(gp_out *out, const gp_spec3d *spec, const gp_result3d *resul
     int failed = 0;
     json_t *head = json_object();
     put(head, "process", json_string("pack3d"), &failed);
-    put(head, "inputs", inputs_json(spec, &failed), &failed);
+    /* the same inputs as the service's validation: every stage the spec asked for */
+    put(head, "inputs", gp_spec3d_json(spec), &failed);
     put(head, "statistics", statistics_json(spec, result, &failed), &failed);
     if (result->has_balance)
         put(head, "balance", gp_json_balance(&result->balance, &failed), &failed);

@@ -48,8 +48,6 @@ json_t *gp_json_counts(const size_t *counts, size_t n, int *failed);
 json_t *gp_json_balance(const gp_balance_result *b, int *failed);
 json_t *gp_json_distribution(const gp_distribution *d, int *failed);
 json_t *gp_json_joint(const gp_joint *j, int *failed);
-/* A 3D spec's "domain": width, height, depth, and "periodic" (["x", "z"], ...) when any. */
-json_t *gp_json_box(const gp_box *box, int *failed);
 /* The polyhedra's statistics as the 3D JSON writes them under "cells" (count, shrink,
  * faces, vertices, volume, faces_per_cell, ...): reads cells->shrink and `stats` only, so
  * a summary decoded from the store serves as well. */

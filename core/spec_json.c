@@ -77,6 +77,20 @@ static json_t *mesh_json(const gp_spec *spec, int *failed)
     return o;
 }
 
+/* The "balance" and "laguerre" blocks, the same in 2D and 3D specs: every field spelled out,
+ * defaults included, so that the inputs a result carries run again to the same result. */
+static json_t *balance_json(const gp_balance_params *b)
+{
+    return json_pack("{s:s, s:i, s:f}", "method", gp_balance_method_name(b->method),
+                     "max_iterations", (int)b->max_iterations, "max_step", b->max_step);
+}
+
+static json_t *laguerre_json(const gp_laguerre_params *l)
+{
+    return json_pack("{s:s, s:b}", "shrink", gp_shrink_name(l->shrink), "flush_boundary",
+                     l->flush_boundary);
+}
+
 json_t *gp_spec_json(const gp_spec *spec)
 {
     int failed = 0;
@@ -91,13 +105,9 @@ json_t *gp_spec_json(const gp_spec *spec)
                          ? json_pack("{s:s, s:i}", "rule", "level_band", "level_band", (int)spec->level_band)
                          : json_pack("{s:s}", "rule", "densest"), &failed);
     if (spec->balance_enabled)
-        put(in, "balance", json_pack("{s:s, s:i, s:f}", "method",
-                                     gp_balance_method_name(spec->balance.method), "max_iterations",
-                                     (int)spec->balance.max_iterations, "max_step",
-                                     spec->balance.max_step), &failed);
+        put(in, "balance", balance_json(&spec->balance), &failed);
     if (spec->laguerre_enabled)
-        put(in, "laguerre", json_pack("{s:s, s:b}", "shrink", gp_shrink_name(spec->laguerre.shrink),
-                                      "flush_boundary", spec->laguerre.flush_boundary), &failed);
+        put(in, "laguerre", laguerre_json(&spec->laguerre), &failed);
     if (spec->mesh_enabled)
         put(in, "mesh", mesh_json(spec, &failed), &failed);
     put(in, "picture", json_pack("{s:s, s:b}", "color",
@@ -110,7 +120,8 @@ json_t *gp_spec_json(const gp_spec *spec)
     return in;
 }
 
-json_t *gp_json_box(const gp_box *box, int *failed)
+/* A 3D spec's "domain": width, height, depth, and "periodic" (["x", "z"], ...) when any. */
+static json_t *json_box(const gp_box *box, int *failed)
 {
     static const char *const axes[] = {"x", "y", "z"};
     json_t *o = json_pack("{s:f, s:f, s:f}", "width", box->width, "height", box->height, "depth", box->depth);
@@ -129,10 +140,14 @@ json_t *gp_spec3d_json(const gp_spec3d *spec)
     static const char *const axes[] = {"x", "y", "z"};
     int failed = 0;
     json_t *in = json_object();
-    put(in, "domain", gp_json_box(&spec->box, &failed), &failed);
+    put(in, "domain", json_box(&spec->box, &failed), &failed);
     put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
     put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
+    if (spec->balance_enabled)
+        put(in, "balance", balance_json(&spec->balance), &failed);
+    if (spec->laguerre_enabled)
+        put(in, "laguerre", laguerre_json(&spec->laguerre), &failed);
     put(in, "picture", json_pack("{s:{s:s, s:f}}", "section", "axis", axes[spec->section.axis],
                                  "at", spec->section.at), &failed);
     if (failed) {

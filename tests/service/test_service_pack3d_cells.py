@@ -101,6 +101,14 @@ def check_downloads(c, api, client, cli, job, st, tmp):
                               f"writes ({len(made)} bytes)")
 
     doc = json.loads(bodies["json"])
+    # the inputs a result carries are the whole job: run again, they give the same document
+    c.check(doc["inputs"]["balance"]["method"] == "relocation" and doc["inputs"]["laguerre"]["shrink"] == "offset",
+            f"json: the result's inputs lost a stage: {sorted(doc['inputs'])}")
+    again_path = os.path.join(tmp, "again.json")
+    with open(again_path, "w") as f:
+        json.dump({"inputs": doc["inputs"]}, f)
+    again = subprocess.run([cli, "run", again_path, "-f", "json"], capture_output=True, check=True).stdout
+    c.check(again == bodies["json"], "json: the result's own inputs do not run to the same result")
     c.check(len(doc["spheres"]) == n and len(doc["polyhedra"]) == n and
             all("F" in s for s in doc["spheres"]), "json: spheres, F, polyhedra")
     stats = {k: v for k, v in st.items() if k not in ("jobID", "timings", "total_seconds", "balance", "cells")}
@@ -170,6 +178,11 @@ def test(c, binary, cli):
         daemon.start()
         client = daemon.client()
         check_refusals(c, api, client)
+        r = client.post_json("/processes/pack3d/validation", spec3d())
+        echoed = r.json().get("inputs", {}) if r.status == 200 else {}
+        c.check(echoed.get("balance", {}).get("method") == "relocation" and
+                echoed.get("laguerre", {}).get("shrink") == "offset",
+                f"validation: the normalised inputs lost a stage: {r.status} {sorted(echoed)}")
         r = client.submit(spec3d(), "pack3d")
         c.check(r.status == 201, f"submission: {r}")
         job = r.json()["jobID"]
