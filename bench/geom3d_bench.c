@@ -1,7 +1,9 @@
 /* geom3d_bench.c - the 3D geometry's figures (bench/PACK3D.md): Laguerre polyhedra per
  * second at 10^5 and 10^6 spheres against the bare regular triangulation's build, and the
- * 3D balancing (F before and after, time) on the three reference laws.
- * Usage: grainpack_geom3d_bench [--max-spheres N] [EXAMPLES_DIR] */
+ * 3D balancing (F before and after, time) on the three reference laws; --periodic the
+ * Laguerre rows alone, in the walled cube then the same cube periodic along all three axes
+ * (its own triangulation of the spheres and their ghosts inside, docs/3d.md §11).
+ * Usage: grainpack_geom3d_bench [--max-spheres N] [--periodic] [EXAMPLES_DIR] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,10 +29,10 @@ static void pack(const gp_box *box, const gp_distribution *dist, const gp_joint 
 
 /* The Laguerre stage at about `target` spheres of radius 0.5 (no joint: shrink none, and
  * offset with a joint of 0.05 for the cost of the second clipping). */
-static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, double target)
+static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, double target, unsigned periodic)
 {
     double side = cbrt(target * (4.0 / 3.0 * M_PI * 0.125) / 0.6);
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, periodic};
     gp_packing3d pk;
     double c0 = cpu();
     pack(&box, one, joint, &pk);
@@ -49,8 +51,8 @@ static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, dou
         if (gp_laguerre3d(&box, pk.spheres, pk.count, rt, &params, NULL, &cells, &err))
             bench_die("gp_laguerre3d", &err);
         double t = cpu() - c0;
-        printf("| %zu | %s | %.2f | %.2f | %.2f | %.0f | %.2f | %.1f | %.2g |\n", pk.count,
-               gp_shrink_name(shrinks[k]), t_pack, t_rt, t, (double)pk.count / t, t / t_rt,
+        printf("| %zu | %s%s | %.2f | %.2f | %.2f | %.0f | %.2f | %.1f | %.2g |\n", pk.count,
+               gp_shrink_name(shrinks[k]), periodic ? " (periodic cube)" : "", t_pack, t_rt, t, (double)pk.count / t, t / t_rt,
                (double)cells.fstart[cells.count] / (double)cells.count,
                (cells.power_volume_sum - side * side * side) / (side * side * side));
         fflush(stdout);
@@ -62,7 +64,7 @@ static void laguerre_rate(const gp_distribution *one, const gp_joint *joint, dou
 
 static void balance_row(const char *name, const gp_spec *spec, double side, gp_balance_method method)
 {
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, 0};
     gp_packing3d pk;
     pack(&box, &spec->dist, &spec->joint, &pk);
     gp_rt3 *rt;
@@ -88,8 +90,11 @@ int main(int argc, char **argv)
 {
     double max_spheres = 1e6;
     const char *examples = "examples";
+    int periodic = 0;
     for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--max-spheres") == 0 && i + 1 < argc)
+        if (strcmp(argv[i], "--periodic") == 0)
+            periodic = 1;
+        else if (strcmp(argv[i], "--max-spheres") == 0 && i + 1 < argc)
             max_spheres = atof(argv[++i]);
         else
             examples = argv[i];
@@ -110,8 +115,17 @@ int main(int argc, char **argv)
     printf("\nLaguerre polyhedra (radius 0.5, joint 0.05, cube at density ~0.6; CPU seconds)\n\n");
     printf("| spheres | shrink | pack s | RT3 build s | Laguerre s | cells / s | Laguerre / RT3 | faces a cell | tiling error |\n");
     printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
-    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
-        laguerre_rate(&one.dist, &joint, n);
+    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10) {
+        laguerre_rate(&one.dist, &joint, n, 0);
+        if (periodic)
+            laguerre_rate(&one.dist, &joint, n, GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z);
+    }
+    if (periodic) {
+        gp_spec_free(&one);
+        gp_spec_free(&bagi);
+        gp_spec_free(&iron);
+        return 0;
+    }
     printf("\nBalancing 3D (boxes of 8 largest diameters, seed 1, rebuild per sweep; CPU seconds)\n\n");
     printf("| law | method | spheres | interior | F_max | mean F | sweeps | s |\n");
     printf("| --- | --- | --- | --- | --- | --- | --- | --- |\n");

@@ -3,9 +3,11 @@
  * and the rate and memory at 10^5 and 10^6 spheres of one radius. --fingerprint prints
  * instead a hash of the reference packings' spheres (a pure speed change must leave them
  * to the bit), --case LAW packs one small box of a law alone (for callgrind's instruction
- * counts: one, bagi or iron; million: the 10^6 packing of one radius of --fingerprint).
+ * counts: one, bagi or iron; million: the 10^6 packing of one radius of --fingerprint),
+ * --periodic the reference laws' rows in a cube periodic along all three axes beside the
+ * walled one (level rule; docs/3d.md §11).
  * Usage: grainpack_pack3d_bench [--seeds N] [--max-spheres N] [--fingerprint] [--case LAW]
- *        [EXAMPLES_DIR] */
+ *        [--periodic] [EXAMPLES_DIR] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,17 +55,21 @@ static double pack_once(const gp_box *box, const gp_distribution *dist, uint64_t
     return t;
 }
 
-/* The law's row: mean and spread of the density over the seeds, spheres, times. */
-static void law_row(const char *name, const gp_distribution *dist, double side, int seeds)
+/* The law's rows: mean and spread of the density over the seeds, spheres, times; both
+ * orders in a walled box, or with `periodic` the level rule in a walled box then in a
+ * fully periodic one. */
+static void law_row(const char *name, const gp_distribution *dist, double side, int seeds, int periodic)
 {
-    static const char *const orders[2] = {"level (walls first)", "lowest first"};
-    gp_box box = {side, side, side};
+    static const char *const orders[3] = {"level (walls first)", "lowest first", "level, periodic cube"};
     for (int o = 0; o < 2; o++) {
+        int row = periodic ? 2 * o : o;
+        gp_box box = {side, side, side, row == 2 ? GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z : 0};
         double sum = 0, sum2 = 0, cpu_sum = 0, wall_sum = 0, lo = 1, hi = 0;
         size_t n = 0;
         for (int s = 1; s <= seeds; s++) {
             gp_packing3d out;
-            double cpu, wall = pack_once(&box, dist, (uint64_t)s, (gp_pack3d_order)o, &out, &cpu);
+            double cpu, wall = pack_once(&box, dist, (uint64_t)s, row == 1 ? GP_PACK3D_LOWEST : GP_PACK3D_LEVEL,
+                                         &out, &cpu);
             double d = out.fill_volume / (side * side * side);
             sum += d;
             sum2 += d * d;
@@ -76,7 +82,7 @@ static void law_row(const char *name, const gp_distribution *dist, double side, 
         }
         double mean = sum / seeds, sd = seeds > 1 ? sqrt(fmax(0, (sum2 - seeds * mean * mean) / (seeds - 1))) : 0;
         printf("| %s | %s | %g | %.0f | %.4f +- %.4f (%.4f-%.4f) | %.1f ms | %.1f ms | %.0f |\n", name,
-               orders[o], side, (double)n / seeds, mean, sd, lo, hi, 1e3 * wall_sum / seeds,
+               orders[row], side, (double)n / seeds, mean, sd, lo, hi, 1e3 * wall_sum / seeds,
                1e3 * cpu_sum / seeds, (double)n / cpu_sum);
         fflush(stdout);
     }
@@ -105,7 +111,7 @@ static void scaling_row(const gp_distribution *dist, double target)
         return;
     }
     double side = scaling_side(target);
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, 0};
     double before = peak_rss(1);
     gp_packing3d out;
     double cpu, wall = pack_once(&box, dist, 1, GP_PACK3D_LEVEL, &out, &cpu);
@@ -134,7 +140,7 @@ static unsigned long long spheres_hash(const gp_packing3d *out)
 static void fingerprint_row(const char *name, const gp_distribution *dist, double side, uint64_t seed,
                             gp_pack3d_order order)
 {
-    gp_box box = {side, side, side};
+    gp_box box = {side, side, side, 0};
     gp_packing3d out;
     double cpu;
     pack_once(&box, dist, seed, order, &out, &cpu);
@@ -150,12 +156,14 @@ int main(int argc, char **argv)
     int seeds = 5;
     double max_spheres = 1e6;
     const char *examples = "examples", *one_case = NULL;
-    int fingerprint = 0;
+    int fingerprint = 0, periodic = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--seeds") && i + 1 < argc)
             seeds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--fingerprint"))
             fingerprint = 1;
+        else if (!strcmp(argv[i], "--periodic"))
+            periodic = 1;
         else if (!strcmp(argv[i], "--case") && i + 1 < argc)
             one_case = argv[++i];
         else if (!strcmp(argv[i], "--max-spheres") && i + 1 < argc)
@@ -205,16 +213,18 @@ int main(int argc, char **argv)
         return 0;
     }
 
-    printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS growth) |\n");
-    printf("|---|---|---|---|---|---|---|---|---|\n");
-    for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
-        scaling_row(&one, n);
+    if (!periodic) { /* with --periodic the laws' rows alone */
+        printf("\n| spheres asked | box side | spheres | density | wall | CPU | spheres/s (wall) | spheres/s (CPU) | bytes per sphere (peak RSS growth) |\n");
+        printf("|---|---|---|---|---|---|---|---|---|\n");
+        for (double n = 1e5; n <= max_spheres * 1.01; n *= 10)
+            scaling_row(&one, n);
+    }
     printf("\n| law | order | box side | spheres | density (mean +- sd, min-max over %d seeds) | wall | CPU | spheres per CPU s |\n",
            seeds);
     printf("|---|---|---|---|---|---|---|---|\n");
-    law_row("one radius 0.5", &one, 20.0, 2); /* the same packing for every seed */
-    law_row("uniform 0.06-0.42 (3D Bagi)", &bagi, 20 * 0.84, seeds);
-    law_row("iron histogram, 2-8 (no joint)", &iron.dist, 20 * 16.0, seeds);
+    law_row("one radius 0.5", &one, 20.0, 2, periodic); /* the same packing for every seed */
+    law_row("uniform 0.06-0.42 (3D Bagi)", &bagi, 20 * 0.84, seeds, periodic);
+    law_row("iron histogram, 2-8 (no joint)", &iron.dist, 20 * 16.0, seeds, periodic);
 
     gp_spec_free(&iron);
     return 0;

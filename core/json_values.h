@@ -40,7 +40,8 @@ void gp_out_json_F(gp_out *out, double F);
  * caller owns, or NULL when out of memory. */
 json_t *gp_spec_json(const gp_spec *spec);
 
-/* The same for a 3D spec: domain (with its depth), distribution, joint, seed. */
+/* The same for a 3D spec: domain (with its depth, and "periodic" as a list of axes when
+ * the box has any), distribution, joint, seed. */
 json_t *gp_spec3d_json(const gp_spec3d *spec);
 
 /* Parts of the above that the 3D writers share (NULL or *failed set when out of memory):

@@ -74,9 +74,13 @@ static int prefer(const p3_packer *pk, const double a[3], const double b[3])
 {
     if (pk->params->order == GP_PACK3D_LOWEST)
         return b[2] < a[2];
+    if (pk->box->periodic == (GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z))
+        return p3_periodic_prefer(pk, a, b);
     const double side[3] = {pk->box->width, pk->box->height, pk->box->depth};
     double da = INFINITY, db = INFINITY;
     for (int k = 0; k < 3; k++) {
+        if (p3_periodic_axis(pk->box, k))
+            continue; /* no wall across it */
         da = min2(da, min2(a[k], side[k] - a[k]));
         db = min2(db, min2(b[k], side[k] - b[k]));
     }
@@ -124,11 +128,18 @@ static int32_t add_sphere(p3_packer *pk, const double p[3], uint32_t level)
     return id;
 }
 
+int32_t p3_add_sphere(p3_packer *pk, const double p[3], uint32_t level)
+{
+    return add_sphere(pk, p, level);
+}
+
 /* Whether a sphere of packing radius R centred at p is inside the box (to GP_CONTACT_RTOL
  * of R: a sphere against a wall is at exactly R from it, up to rounding) and overlaps no
  * sphere. */
 static int fits(p3_packer *pk, const double p[3], double R)
 {
+    if (pk->box->periodic)
+        return p3_periodic_fits(pk, p, R);
     const double side[3] = {pk->box->width, pk->box->height, pk->box->depth};
     double slack = R * GP_CONTACT_RTOL;
     for (int a = 0; a < 3; a++)
@@ -189,13 +200,18 @@ static int try_triangle(p3_packer *pk, int32_t t)
     p3_tri tri = pk->fr.tris[t];
     double R = pk->pending_R, pos[2][3];
     int n = p3_tangent(pk->spheres, pk->box, tri.m, R, pos);
+    for (int s = 0; pk->box->periodic && s < n; s++)
+        p3_wrap(pk->box, pos[s]); /* a sphere across a periodic side: its image inside */
     if (n == 2 && tri.behind != P3_NONE) {
         /* the two positions mirror each other: the one nearer the sphere behind is filled */
         const gp_sphere *b = &pk->spheres[tri.behind];
         double d[2];
-        for (int s = 0; s < 2; s++)
-            d[s] = (pos[s][0] - b->x) * (pos[s][0] - b->x) + (pos[s][1] - b->y) * (pos[s][1] - b->y) +
-                   (pos[s][2] - b->z) * (pos[s][2] - b->z);
+        for (int s = 0; s < 2; s++) {
+            double v[3] = {pos[s][0] - b->x, pos[s][1] - b->y, pos[s][2] - b->z};
+            if (pk->box->periodic)
+                p3_min_image(pk->box, v);
+            d[s] = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        }
         if (d[0] < d[1])
             memcpy(pos[0], pos[1], sizeof pos[0]);
         n = 1;
@@ -264,6 +280,16 @@ int gp_pack3d_check(const gp_box *b, const gp_distribution *dist, const gp_joint
     if (!(R_min > 0.0) || !isfinite(R_max))
         return gp_error_set(err, GP_EINVAL, "/distribution",
                             "packing radii must be positive and finite, got %g to %g", R_min, R_max);
+    if (b->periodic & ~(GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z))
+        return gp_error_set(err, GP_EINVAL, "/domain/periodic", "unknown periodic axes 0x%x", b->periodic);
+    for (int a = 0; a < 3; a++)
+        if ((b->periodic & (1u << a)) && !(side[a] >= GP_PACK_MIN_PERIOD_RADII * R_max))
+            return gp_error_set(err, GP_EINVAL, "/domain/periodic",
+                                "a periodic side must be at least %g largest packing radii long (%g "
+                                "for R_max = %g), so that only the nearest image of a sphere can "
+                                "touch another; the box's %s is %g (docs/3d.md §11)",
+                                GP_PACK_MIN_PERIOD_RADII, GP_PACK_MIN_PERIOD_RADII * R_max, R_max,
+                                names[a] + 8, side[a]);
     for (int a = 0; a < 3; a++)
         if (!(side[a] >= 2.0 * R_max))
             return gp_error_set(err, GP_EINVAL, names[a],
@@ -349,9 +375,12 @@ int gp_pack3d(const gp_pack3d_params *params, const gp_progress *progress, gp_pa
     rc = setup(&pk);
     if (rc == 0) {
         draw_radius(&pk);
-        /* the first triangle: the corner of the three walls at the origin */
+        /* the first triangle: the corner of the three walls at the origin; on a periodic
+         * box, those of a seed cluster (pack3d_periodic.c) */
         const int32_t corner[3] = {P3_WALL(0), P3_WALL(2), P3_WALL(4)};
-        if (p3_front_push(&pk.fr, corner, P3_NONE, 0))
+        if (params->box->periodic)
+            rc = p3_periodic_start(&pk);
+        else if (p3_front_push(&pk.fr, corner, P3_NONE, 0))
             rc = gp_error_set(err, GP_ENOMEM, NULL, "out of memory for the front");
     }
     if (rc == 0)

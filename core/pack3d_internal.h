@@ -1,6 +1,6 @@
 /* pack3d_internal.h - the parts of the 3D packer (internal to core/, docs/3d.md):
  * pack3d_grid.c the bucket grid, pack3d_solve.c the tangency solve, pack3d_front.c the
- * front of triangles, pack3d.c the loop. */
+ * front of triangles, pack3d.c the loop, pack3d_periodic.c periodic boxes. */
 #ifndef GRAINPACK_CORE_PACK3D_INTERNAL_H
 #define GRAINPACK_CORE_PACK3D_INTERNAL_H
 
@@ -69,7 +69,9 @@ int p3_overlap(double ax, double ay, double az, double aR, const gp_sphere *b);
 
 /* The centres of the spheres of radius R tangent to the three members of a triangle
  * (spheres from `spheres`, walls of `box`): writes up to two into out[] and returns how
- * many (0 when there is none: spheres too far apart, collinear centres, two opposite walls). */
+ * many (0 when there is none: spheres too far apart, collinear centres, two opposite walls).
+ * On a periodic box the sphere members are taken at their images nearest the first one,
+ * and the centres returned may lie outside [0, side) along a periodic axis (p3_wrap). */
 int p3_tangent(const gp_sphere *spheres, const gp_box *box, const int32_t m[3], double R,
                double out[2][3]);
 
@@ -161,5 +163,46 @@ uint32_t p3_key(const p3_packer *pk, const int32_t m[3]);
  * none) is the triangle c was placed on: a new triangle of two of its members has the
  * third behind it. Returns 0 or GP_ENOMEM. */
 int p3_link(p3_packer *pk, int32_t c, int32_t parent);
+
+/* Appends the pending radius as a sphere at p (inside the box, wrapped) with this level,
+ * draws the next radius (pack3d.c). Returns its id or a negative GP_E code with err set. */
+int32_t p3_add_sphere(p3_packer *pk, const double p[3], uint32_t level);
+
+/* ---- periodic boxes (pack3d_periodic.c, docs/3d.md §11) ---- */
+
+/* Whether axis a of the box is periodic. */
+static inline int p3_periodic_axis(const gp_box *box, int a)
+{
+    return (box->periodic >> a) & 1u;
+}
+
+/* Turns the vector d between two points into the shortest between their images along the
+ * box's periodic axes (the minimum image; unchanged along walled axes). Both points must
+ * lie in [0, side) along those axes (stored centres and wrapped positions do). */
+void p3_min_image(const gp_box *box, double d[3]);
+/* Brings p into [0, side) along the box's periodic axes. */
+void p3_wrap(const gp_box *box, double p[3]);
+/* The cells a ball of radius `reach` around p meets: along each axis `count[a]` cells from
+ * lo[a] on, to be taken modulo n[a] (p3_wrap_cell) on a periodic axis, where a range as
+ * wide as the grid is every cell once. */
+void p3_grid_span(const p3_grid *grid, unsigned periodic, const double p[3], double reach, int32_t lo[3],
+                  int32_t count[3]);
+/* Cell index i (0 <= i < 2 n) of a span, modulo n. */
+static inline int32_t p3_wrap_cell(int32_t i, int32_t n)
+{
+    return i >= n ? i - n : i;
+}
+/* fits() on a periodic box: the sphere (p, R) inside along the walled axes (to
+ * GP_CONTACT_RTOL of R) and overlapping no sphere's nearest image; sets pk->blocker to the
+ * sphere in the way. */
+int p3_periodic_fits(p3_packer *pk, const double p[3], double R);
+/* Of two positions that both fit in a box with no wall, whether b is preferred to a: the
+ * one nearer the seed cluster (the first sphere's centre, minimum image), so that the
+ * front fills behind itself before it moves outward as it does from the walls. */
+int p3_periodic_prefer(const p3_packer *pk, const double a[3], const double b[3]);
+/* The initial front of a box with a periodic axis: a seed cluster of spheres against the
+ * walls left (three mutually tangent ones when there is none), linked. 0 or a GP_E code
+ * with err set. */
+int p3_periodic_start(p3_packer *pk);
 
 #endif

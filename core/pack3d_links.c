@@ -52,11 +52,57 @@ static int keep_nearest(link *links, int n, const link *l)
     return n;
 }
 
+/* Appends the walls linked with sphere s after the n links, returns the new count. A
+ * periodic axis has no walls. */
+static int gather_walls(const p3_packer *pk, const gp_sphere *s, link *links, int n)
+{
+    for (int w = 0; w < P3_WALLS; w++) {
+        if (p3_periodic_axis(pk->box, w / 2))
+            continue;
+        double gap = wall_gap(pk, s->x, s->y, s->z, s->R, w);
+        if (gap < pk->gap * pk->R_max)
+            links[n++] = (link){P3_WALL(w), gap, 0.0, 0.0, 0.0, 0.0};
+    }
+    return n;
+}
+
+/* gather() on a periodic box: the grid's cells modulo the box, each sphere at its image
+ * nearest c (so that the links' centres, relative to c and to each other, are those of
+ * the images that touch: GP_PACK_MIN_PERIOD_RADII keeps them within half a side). */
+static int gather_periodic(const p3_packer *pk, int32_t c, link *links)
+{
+    const gp_sphere *s = &pk->spheres[c];
+    const p3_grid *grid = &pk->grid;
+    const double p[3] = {s->x, s->y, s->z};
+    int32_t lo[3], count[3];
+    p3_grid_span(grid, pk->box->periodic, p, s->R + pk->R_max + pk->gap * pk->R_max, lo, count);
+    int n = 0;
+    for (int32_t k = lo[2]; k < lo[2] + count[2]; k++)
+        for (int32_t j = lo[1]; j < lo[1] + count[1]; j++)
+            for (int32_t i = lo[0]; i < lo[0] + count[0]; i++) {
+                int32_t q = p3_grid_cell(grid, p3_wrap_cell(i, grid->n[0]), p3_wrap_cell(j, grid->n[1]),
+                                         p3_wrap_cell(k, grid->n[2]));
+                for (; q != P3_NONE; q = grid->next[q]) {
+                    const gp_sphere *o = &pk->spheres[q];
+                    double d[3] = {o->x - s->x, o->y - s->y, o->z - s->z};
+                    p3_min_image(pk->box, d);
+                    double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], reach = link_reach(pk, s->R, o->R);
+                    if (d2 < reach * reach && q != c) {
+                        link l = {q, sqrt(d2) - s->R - o->R, s->x + d[0], s->y + d[1], s->z + d[2], o->R};
+                        n = keep_nearest(links, n, &l);
+                    }
+                }
+            }
+    return gather_walls(pk, s, links, n);
+}
+
 /* The spheres linked with c, nearest first (at most P3_LINKS; of equal gaps, the first met
  * in the grid's order), then the walls. (Skipping the cells of the range beyond the reach
  * cost more than it saved: 14 325 -> 15 378 instructions a sphere, one radius.) */
 static int gather(const p3_packer *pk, int32_t c, link *links)
 {
+    if (pk->box->periodic)
+        return gather_periodic(pk, c, links);
     const gp_sphere *s = &pk->spheres[c];
     const p3_grid *grid = &pk->grid;
     double query = s->R + pk->R_max + pk->gap * pk->R_max;
@@ -84,12 +130,7 @@ static int gather(const p3_packer *pk, int32_t c, link *links)
             }
         }
     }
-    for (int w = 0; w < P3_WALLS; w++) {
-        double gap = wall_gap(pk, s->x, s->y, s->z, s->R, w);
-        if (gap < pk->gap * pk->R_max)
-            links[n++] = (link){P3_WALL(w), gap, 0.0, 0.0, 0.0, 0.0};
-    }
-    return n;
+    return gather_walls(pk, s, links, n);
 }
 
 /* The bit masks adj[] of the links within the link gap of each other (walls across an

@@ -134,6 +134,13 @@ int p3_tangent(const gp_sphere *spheres, const gp_box *box, const int32_t m[3], 
             c[ns][0] = s->x;
             c[ns][1] = s->y;
             c[ns][2] = s->z;
+            if (box->periodic && ns > 0) {
+                /* the image of the member nearest the first sphere member (docs/3d.md §11) */
+                double d[3] = {c[ns][0] - c[0][0], c[ns][1] - c[0][1], c[ns][2] - c[0][2]};
+                p3_min_image(box, d);
+                for (int a = 0; a < 3; a++)
+                    c[ns][a] = c[0][a] + d[a];
+            }
             rho[ns++] = s->R + R;
         }
     }

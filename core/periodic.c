@@ -8,6 +8,23 @@
 #include "grainpack/error.h"
 #include "grow.h"
 
+int periodic_append(void **all, size_t *cap, size_t *count, size_t n, const void *item, size_t size,
+                    int32_t **from, size_t *from_cap, int32_t origin)
+{
+    void *grown = grow(*all, cap, *count + 1, size);
+    if (!grown)
+        return GP_ENOMEM;
+    *all = grown;
+    int32_t *grown_from = grow(*from, from_cap, *count - n + 1, sizeof *grown_from);
+    if (!grown_from)
+        return GP_ENOMEM;
+    *from = grown_from;
+    memcpy((char *)grown + *count * size, item, size);
+    grown_from[*count - n] = origin;
+    ++*count;
+    return 0;
+}
+
 int periodic_images(const gp_domain *domain, const gp_disk *disks, size_t n, double margin,
                     gp_disk **out, int32_t **origin, size_t *n_out)
 {
@@ -27,19 +44,14 @@ int periodic_images(const gp_domain *domain, const gp_disk *disks, size_t n, dou
                 if ((sx == 0 && sy == 0) || (kx && !(x >= -margin && x < W + margin)) ||
                     (ky && !(y >= -margin && y < H + margin)))
                     continue;
-                gp_disk *grown = grow(all, &cap, m + 1, sizeof *grown);
-                if (!grown)
+                gp_disk image = disks[i];
+                image.x = x;
+                image.y = y;
+                void *a = all;
+                int rc = periodic_append(&a, &cap, &m, n, &image, sizeof image, &from, &from_cap, (int32_t)i);
+                all = a;
+                if (rc)
                     goto oom;
-                all = grown;
-                int32_t *grown_from = grow(from, &from_cap, m - n + 1, sizeof *grown_from);
-                if (!grown_from)
-                    goto oom;
-                from = grown_from;
-                all[m] = disks[i];
-                all[m].x = x;
-                all[m].y = y;
-                from[m - n] = (int32_t)i;
-                m++;
             }
         }
     }

@@ -22,6 +22,13 @@
 int periodic_images(const gp_domain *domain, const gp_disk *disks, size_t n, double margin,
                     gp_disk **out, int32_t **origin, size_t *n_out);
 
+/* Appends `item` (`size` bytes) as element *count of *all (room for *cap) and its origin
+ * as element *count - n of *from (room for *from_cap), growing both; the images of
+ * periodic_images here and of the 3D cells (laguerre3d.c). Returns 0 or GP_ENOMEM (the
+ * arrays then unchanged, still the caller's). */
+int periodic_append(void **all, size_t *cap, size_t *count, size_t n, const void *item, size_t size,
+                    int32_t **from, size_t *from_cap, int32_t origin);
+
 /* The first ghost margin of the cells, F and balancing, in largest packing radii: a
  * dense packing's power cell reaches about one radius past its disk, so its vertices'
  * power circles stay within a few radii; a margin too small is found out cell by cell

@@ -103,6 +103,9 @@ int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progre
                       gp_result3d *result, gp_error *err)
 {
     memset(result, 0, sizeof *result);
+    if (spec->box.periodic && (spec->balance_enabled || spec->laguerre_enabled))
+        return gp_error_set(err, GP_EINVAL, spec->balance_enabled ? "/balance" : "/laguerre",
+                            "is not yet available on periodic boxes (docs/3d.md §11)");
     gp_pack3d_params params = gp_spec3d_pack_params(spec, max_spheres);
     double t = now_seconds();
     int rc = gp_pack3d(&params, progress, &result->packing, err);

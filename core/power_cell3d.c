@@ -38,8 +38,9 @@ int power_cell3d_box(power_cell3d *pc)
     static const int32_t walls[6] = {GP_WALL3D(0), GP_WALL3D(1), GP_WALL3D(2),
                                      GP_WALL3D(3), GP_WALL3D(4), GP_WALL3D(5)};
     const gp_sphere *p = pc->p;
-    double lo[3] = {-p->x, -p->y, -p->z};
-    double hi[3] = {pc->box->width - p->x, pc->box->height - p->y, pc->box->depth - p->z};
+    const double *g = pc->grow;
+    double lo[3] = {-g[0] - p->x, -g[1] - p->y, -g[2] - p->z};
+    double hi[3] = {pc->box->width + g[0] - p->x, pc->box->height + g[1] - p->y, pc->box->depth + g[2] - p->z};
     return poly_box(&pc->a, lo, hi, walls);
 }
 
@@ -75,8 +76,9 @@ int power_cell3d_build(power_cell3d *pc, int32_t i, const int32_t *ring, size_t 
         return GP_ENOMEM;
     pc->order = order;
     const gp_box *box = pc->box;
-    *holds_centre = p->x > 0.0 && p->x < box->width && p->y > 0.0 && p->y < box->height &&
-                    p->z > 0.0 && p->z < box->depth;
+    const double *g = pc->grow;
+    *holds_centre = p->x > -g[0] && p->x < box->width + g[0] && p->y > -g[1] && p->y < box->height + g[1] &&
+                    p->z > -g[2] && p->z < box->depth + g[2];
     /* the radical plane of p against q: |u|^2 - R_p^2 <= |u - n|^2 - R_q^2, n = q - p; for
      * spheres apart c = (d^2 + R_p^2 - R_q^2) / 2 >= R_p (R_p + R_q) > 0 */
     for (size_t k = 0; k < degree; k++) {

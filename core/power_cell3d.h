@@ -30,6 +30,8 @@ typedef struct plane3 {
  * face's label is the neighbour's position in the ring (>= 0) or GP_WALL3D(k). */
 typedef struct power_cell3d {
     const gp_box *box;
+    double grow[3];      /* the box grown by this on both sides of each axis (the ghost
+                          * margin of a periodic axis, laguerre3d.c); 0 on walled axes */
     const gp_sphere *spheres;
     const gp_sphere *p;  /* the sphere of the cell */
     const int32_t *ring; /* its ring */
@@ -49,7 +51,7 @@ typedef struct power_cell3d {
 int power_cell3d_build(power_cell3d *pc, int32_t i, const int32_t *ring, size_t degree,
                        int *holds_centre);
 
-/* Starts pc->a as the box relative to pc->p's centre (0 or GP_ENOMEM). */
+/* Starts pc->a as the box (grown by pc->grow) relative to pc->p's centre (0 or GP_ENOMEM). */
 int power_cell3d_box(power_cell3d *pc);
 
 /* Wall k (GP_WALL3D's numbering) as a half-space relative to p, moved inward by inset. */

@@ -150,11 +150,14 @@ static int get_choice(validator *v, const json_t *obj, const char *base, const c
                         json_string_value(value));
 }
 
-/* "periodic": true (both axes), false, or an array of distinct "x", "y" (docs/method.md
- * §3.8); absent is false. */
-static int parse_periodic(validator *v, const json_t *obj, const char *base, unsigned *out)
+/* "periodic": true (every axis), false, or an array of distinct axis names, "x", "y" for
+ * a domain (docs/method.md §3.8) and "z" too for a box (docs/3d.md §11); absent is false.
+ * Axis k sets bit 1 << k (GP_PERIODIC_X, _Y, _Z). */
+int spec_parse_periodic(validator *v, const json_t *obj, const char *base, int axes, unsigned *out)
 {
-    static const char expected[] = "true, false or an array of distinct \"x\", \"y\"";
+    const char *expected = axes == 3 ? "true, false or an array of distinct \"x\", \"y\", \"z\""
+                                     : "true, false or an array of distinct \"x\", \"y\"";
+    const char *names = axes == 3 ? "\"x\", \"y\" or \"z\"" : "\"x\" or \"y\"";
     char ptr[GP_ERROR_POINTER_MAX], item_ptr[GP_ERROR_POINTER_MAX];
     spec_pointer_key(ptr, base, "periodic");
     const json_t *value = json_object_get(obj, "periodic");
@@ -162,7 +165,7 @@ static int parse_periodic(validator *v, const json_t *obj, const char *base, uns
     if (!value || json_is_false(value))
         return 0;
     if (json_is_true(value)) {
-        *out = GP_PERIODIC_X | GP_PERIODIC_Y;
+        *out = (1u << axes) - 1;
         return 0;
     }
     if (!json_is_array(value))
@@ -172,10 +175,11 @@ static int parse_periodic(validator *v, const json_t *obj, const char *base, uns
     json_array_foreach(value, i, item) {
         pointer_index(item_ptr, ptr, i);
         const char *axis = json_is_string(item) ? json_string_value(item) : NULL;
-        unsigned bit = !axis ? 0 : strcmp(axis, "x") == 0 ? GP_PERIODIC_X
-                                 : strcmp(axis, "y") == 0 ? GP_PERIODIC_Y : 0;
+        unsigned bit = axis && strlen(axis) == 1 && axis[0] >= 'x' && axis[0] < 'x' + axes
+                           ? 1u << (axis[0] - 'x')
+                           : 0;
         if (!bit)
-            return gp_error_set(v->err, GP_EINVAL, item_ptr, "must be \"x\" or \"y\", got %s",
+            return gp_error_set(v->err, GP_EINVAL, item_ptr, "must be %s, got %s", names,
                                 type_phrase(item));
         if (*out & bit)
             return gp_error_set(v->err, GP_EINVAL, item_ptr, "repeats \"%s\"; expected %s", axis,
@@ -199,7 +203,7 @@ static int parse_domain(validator *v, const json_t *inputs, const char *base, gp
         return rc;
     if ((rc = spec_get_number(v, obj, ptr, "height", 0.0, 0, &dom->height)))
         return rc;
-    return parse_periodic(v, obj, ptr, &dom->periodic);
+    return spec_parse_periodic(v, obj, ptr, 2, &dom->periodic);
 }
 
 static int parse_histogram(validator *v, const json_t *obj, const char *base, gp_distribution *d)

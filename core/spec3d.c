@@ -45,13 +45,14 @@ static int parse_box(validator *v, const json_t *inputs, const char *base, gp_bo
     int rc = spec_get_object(v, inputs, base, "domain", 1, &obj, ptr);
     if (rc)
         return rc;
-    static const char *const members[] = {"width", "height", "depth", NULL};
-    if ((rc = spec_check_members(v, obj, ptr, members, "width, height, depth (a 3D box has walls)")))
+    static const char *const members[] = {"width", "height", "depth", "periodic", NULL};
+    if ((rc = spec_check_members(v, obj, ptr, members, "width, height, depth, periodic")))
         return rc;
     if ((rc = spec_get_number(v, obj, ptr, "width", 0.0, 0, &box->width)) ||
-        (rc = spec_get_number(v, obj, ptr, "height", 0.0, 0, &box->height)))
+        (rc = spec_get_number(v, obj, ptr, "height", 0.0, 0, &box->height)) ||
+        (rc = spec_get_number(v, obj, ptr, "depth", 0.0, 0, &box->depth)))
         return rc;
-    return spec_get_number(v, obj, ptr, "depth", 0.0, 0, &box->depth);
+    return spec_parse_periodic(v, obj, ptr, 3, &box->periodic);
 }
 
 /* "picture": {"section": {"axis": "x" | "y" | "z", "at": [0, 1]}}, both optional. */
@@ -89,13 +90,19 @@ static int parse_picture(validator *v, const json_t *inputs, const char *base, g
     return 0;
 }
 
-/* What spans the fields: the packer's own check (gp_pack3d_check, its pointer under
- * base), then the cap on the expected spheres. */
+/* What spans the fields: the stages not yet on periodic boxes, the packer's own check
+ * (gp_pack3d_check, its pointer under base), then the cap on the expected spheres. */
 static int check_whole(validator *v, const char *base, gp_spec3d *spec)
 {
     double r_min, r_max;
     gp_distribution_support(&spec->dist, &r_min, &r_max);
     char ptr[GP_ERROR_POINTER_MAX];
+    if (spec->box.periodic && (spec->balance_enabled || spec->laguerre_enabled)) {
+        spec_pointer_key(ptr, base, spec->balance_enabled ? "balance" : "laguerre");
+        return gp_error_set(v->err, GP_EINVAL, ptr,
+                            "is not yet available on periodic boxes (docs/3d.md §11); leave it out, "
+                            "or leave out the domain's \"periodic\"");
+    }
     if (!(r_max > 0.0)) {
         spec_pointer_key(ptr, base, "distribution");
         return gp_error_set(v->err, GP_EINVAL, ptr, "must give some bin a probability > 0");

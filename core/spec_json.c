@@ -120,13 +120,27 @@ json_t *gp_spec_json(const gp_spec *spec)
     return in;
 }
 
+/* A 3D spec's "domain": width, height, depth, and "periodic" (["x", "z"], ...) when any. */
+static json_t *json_box(const gp_box *box, int *failed)
+{
+    static const char *const axes[] = {"x", "y", "z"};
+    json_t *o = json_pack("{s:f, s:f, s:f}", "width", box->width, "height", box->height, "depth", box->depth);
+    if (box->periodic) { /* as the list form of the spec; a walled box writes nothing more */
+        json_t *list = json_array();
+        for (int a = 0; a < 3; a++)
+            if (((box->periodic >> a) & 1u) && (!list || json_array_append_new(list, json_string(axes[a]))))
+                *failed = 1;
+        put(o, "periodic", list, failed);
+    }
+    return o;
+}
+
 json_t *gp_spec3d_json(const gp_spec3d *spec)
 {
     static const char *const axes[] = {"x", "y", "z"};
     int failed = 0;
     json_t *in = json_object();
-    put(in, "domain", json_pack("{s:f, s:f, s:f}", "width", spec->box.width, "height",
-                                spec->box.height, "depth", spec->box.depth), &failed);
+    put(in, "domain", json_box(&spec->box, &failed), &failed);
     put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
     put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);

@@ -32,6 +32,10 @@ int spec_get_object(validator *v, const json_t *parent, const char *base, const 
 /* Reads a required finite number that must be > lower (or >= lower when `inclusive`). */
 int spec_get_number(validator *v, const json_t *obj, const char *base, const char *key, double lower,
                     int inclusive, double *out);
+/* "periodic" of a domain (axes 2) or a box (axes 3) object `obj` whose pointer is base:
+ * true, false, absent or an array of distinct axis names; *out gets bit 1 << k per
+ * periodic axis k. */
+int spec_parse_periodic(validator *v, const json_t *obj, const char *base, int axes, unsigned *out);
 /* "distribution" (required; not yet prepared), "joint" (optional), "seed" (optional). */
 int spec_parse_distribution(validator *v, const json_t *inputs, const char *base, gp_distribution *d);
 int spec_parse_joint(validator *v, const json_t *inputs, const char *base, gp_joint *j);

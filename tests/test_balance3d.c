@@ -27,7 +27,7 @@ static law3 laws[3] = {
 
 static int pack(const law3 *law, uint64_t seed, double side, gp_box *box, gp_packing3d *out)
 {
-    *box = (gp_box){side, side * 0.9, side * 1.1};
+    *box = (gp_box){side, side * 0.9, side * 1.1, 0};
     gp_pack3d_params p = {.box = box, .dist = &law->spec.dist, .joint = &law->spec.joint, .seed = seed};
     gp_error err;
     int rc = gp_pack3d(&p, NULL, out, &err);

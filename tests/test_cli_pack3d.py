@@ -1,8 +1,8 @@
 """test_cli_pack3d.py - `grainpack run` and `validate` on 3D specs (docs/3d.md): the process
 detected from the domain's "depth" or given by --process, the CSV read back by Python's csv
 module and checked on its own (no overlap beyond 1e-9, inside the box, the header), the
-same bytes from a file and from stdin, and the refusals with their exit statuses and JSON
-pointers. Usage: test_cli_pack3d.py PATH/TO/grainpack EXAMPLES_DIR"""
+same bytes from a file and from stdin, a box periodic along two axes checked under the
+minimum image, and the refusals with their exit statuses and JSON pointers. Usage: test_cli_pack3d.py PATH/TO/grainpack EXAMPLES_DIR"""
 import csv
 import io
 import json
@@ -75,7 +75,28 @@ with tempfile.TemporaryDirectory() as tmp:
     refused({"domain": dict(box, depth=-1), "distribution": law}, 3, "/domain/depth")
     refused({"domain": box, "distribution": {"kind": "uniform", "min": 0.01, "max": 0.3}}, 3,
             "/distribution/min")
-    refused({"domain": dict(box, periodic=["x"]), "distribution": law}, 3, "/domain/periodic")
+    # a periodic side under 12 R_max (3.6 here), a periodic axis that is not one, and the
+    # stages not yet on periodic boxes
+    refused({"domain": dict(box, depth=3, periodic=["z"]), "distribution": law}, 3, "/domain/periodic")
+    refused({"domain": dict(box, periodic=["t"]), "distribution": law}, 3, "/domain/periodic/0")
+    refused({"domain": dict(box, periodic=True), "distribution": law,
+             "laguerre": {"shrink": "offset"}}, 3, "/laguerre")
+    # periodic along x and z: centres in [0, side) there, spheres inside along y, no two
+    # overlapping under the minimum image (the CSV's own positions)
+    rc, got, err = run(["run", "-", "-f", "csv"],
+                       stdin=json.dumps({"domain": dict(box, periodic=["x", "z"]), "distribution": law}).encode())
+    check(rc == 0, "periodic run exited %d: %s" % (rc, err))
+    p = [tuple(float(v) for v in row) for row in list(csv.reader(io.StringIO(got.decode())))[1:]]
+    sides = (6.0, 5.0, 4.0)
+    check(len(p) > 100 and all(0 <= c[0] < 6 and 0 <= c[2] < 4 and 0.3 - 1e-9 <= c[1] <= 4.7 + 1e-9 for c in p),
+          "periodic: %d spheres, or one outside" % len(p))
+    worst = -1.0
+    for i in range(len(p)):
+        for j in range(i):
+            d = [p[i][k] - p[j][k] for k in range(3)]
+            d = [v - sides[k] * round(v / sides[k]) if k != 1 else v for k, v in enumerate(d)]
+            worst = max(worst, 1.0 - math.sqrt(sum(v * v for v in d)) / 0.6)
+    check(worst <= 1e-9, "periodic: worst overlap %g" % worst)
     # balanced by relocation: F_max does not rise, the spheres stay apart and in the box
     # (the JSON's own positions, checked here), F is given where a centre is interior
     balanced = json.loads(json.dumps(SPEC))

@@ -32,7 +32,7 @@ static law3 laws[3] = {
 
 static int pack(const law3 *law, uint64_t seed, gp_box *box, gp_packing3d *out)
 {
-    *box = (gp_box){law->side, law->side * 0.9, law->side * 1.1};
+    *box = (gp_box){law->side, law->side * 0.9, law->side * 1.1, 0};
     gp_pack3d_params p = {.box = box, .dist = &law->spec.dist, .joint = &law->spec.joint, .seed = seed};
     gp_error err;
     int rc = gp_pack3d(&p, NULL, out, &err);
@@ -300,7 +300,7 @@ static void test_refusals(void)
     gp_error err;
     CHECK(gp_rt3_build(s, 3, NULL, &rt, &err) == GP_EGEOM && rt == NULL);
     gp_sphere lap[3] = {{1, 1, 1, 0.5, 0.5}, {1.1, 1, 1, 0.1, 0.1}, {2, 2, 2, 0.5, 0.5}};
-    gp_box box = {3, 3, 3};
+    gp_box box = {3, 3, 3, 0};
     gp_laguerre_params params = {GP_SHRINK_NONE, 0};
     gp_cells3d c;
     CHECK(gp_rt3_build(lap, 3, NULL, &rt, &err) == 0);

@@ -10,6 +10,7 @@
 #include "grainpack/pack3d.h"
 #include "grainpack/spec.h"
 #include "pack3d_internal.h"
+#include "pack3d_laws.h"
 
 /* Relative overlap and boundary tolerances, as tests/packing_checks.h's (1e-9: a
  * thousandfold above the rounding of a tangent placement, far below any real overlap). */
@@ -17,9 +18,7 @@
 /* A contact: a centre distance within this of R1 + R2, relative (rounding of the solve is
  * ~1e-15; 1e-9 still tells a touching sphere from one a hair away). */
 #define CONTACT_RTOL 1e-9
-#define MAX_Z 4.0
 #define SEEDS 24
-#define MAX_BINS 64
 
 /* ---- independent checks ---- */
 
@@ -117,47 +116,15 @@ static size_t count_loose(const gp_sphere *s, size_t n, const gp_box *box)
     return loose;
 }
 
-/* ---- the laws ---- */
-
-typedef struct law3 {
-    const char *name;
-    int seeds;        /* a law of one radius packs the same for every seed: two suffice */
-    gp_spec spec;     /* owns the law */
-    double side;      /* box side */
-    double min_density; /* floor over the seeds: ~0.03 under the lowest measured */
-} law3;
-
-static int load_law(law3 *law, const char *json)
-{
-    gp_error err;
-    if (gp_spec_parse(json, strlen(json), NULL, &law->spec, &err)) {
-        fprintf(stderr, "%s: %s\n", law->name, err.message);
-        return -1;
-    }
-    return 0;
-}
-
-static int load_iron(law3 *law)
-{
-    gp_error err;
-    if (gp_spec_load_file(GP_EXAMPLES_DIR "/iron.json", NULL, &law->spec, &err)) {
-        fprintf(stderr, "iron: %s\n", err.message);
-        return -1;
-    }
-    law->spec.joint = (gp_joint){0}; /* the radii alone: the 3D iron case has no joint */
-    return 0;
-}
-
 /* ---- the properties ---- */
 
 static void check_law(law3 *law, gp_pack3d_order order, int seeds)
 {
     const gp_distribution *dist = &law->spec.dist;
-    gp_box box = {law->side, law->side * 0.9, law->side * 1.1};
-    gp_bin bins[MAX_BINS];
-    size_t nb = gp_distribution_report_bins(dist, bins, MAX_BINS);
-    double counts[MAX_BINS] = {0};
-    size_t pooled = 0, worst_loose = 0;
+    gp_box box = {law->side, law->side * 0.9, law->side * 1.1, 0};
+    law3_tally tally;
+    law3_tally_init(&tally, dist);
+    size_t worst_loose = 0;
     double worst_overlap = -1.0, min_density = 1.0;
     for (int seed = 1; seed <= seeds; seed++) {
         gp_pack3d_params params = {&box, dist, NULL, (uint64_t)seed * 7919u, 0, order};
@@ -175,45 +142,15 @@ static void check_law(law3 *law, gp_pack3d_order order, int seeds)
         size_t loose = count_loose(out.spheres, out.count, &box);
         CHECK_MSG(loose == 0, "%s seed %d: %zu spheres touch fewer than three", law->name, seed, loose);
         worst_loose = loose > worst_loose ? loose : worst_loose;
-        /* the radii are the law's draws in order: the seed's generator gives them again */
-        gp_rng rng;
-        gp_rng_seed(&rng, params.seed);
-        size_t same = 0;
-        for (size_t i = 0; i < out.count; i++)
-            same += gp_distribution_sample(dist, &rng) == out.spheres[i].r && out.spheres[i].r == out.spheres[i].R;
-        CHECK_MSG(same == out.count, "%s seed %d: %zu of %zu radii are the draws", law->name, seed, same,
-                  out.count);
-        /* bounded work (docs/3d.md §5): triangles per sphere and tries per triangle */
-        size_t links = P3_LINKS + P3_WALLS;
-        CHECK(out.triangles <= 1 + out.count * (links * (links - 1) / 2));
-        CHECK(out.attempts <= out.triangles * P3_CLASSES + out.count);
-        double volume = 0.0;
-        for (size_t i = 0; i < out.count; i++)
-            volume += 4.0 / 3.0 * M_PI * pow(out.spheres[i].R, 3);
-        CHECK_NEAR(volume, out.fill_volume, 1e-9 * volume);
-        double density = volume / (box.width * box.height * box.depth);
+        double density = law3_check_packing(law->name, seed, &params, &out);
         min_density = fmin(min_density, density);
         CHECK_MSG(density >= law->min_density, "%s seed %d: density %.4f", law->name, seed, density);
-        for (size_t i = 0; i < out.count; i++)
-            for (size_t b = 0; b < nb; b++)
-                if (out.spheres[i].r >= bins[b].min && (out.spheres[i].r < bins[b].max || b + 1 == nb)) {
-                    counts[b]++;
-                    break;
-                }
-        pooled += out.count;
+        law3_tally_add(&tally, &out);
         gp_packing3d_free(&out);
     }
-    double max_z = 0.0;
-    for (size_t b = 0; b < nb; b++) {
-        double p = bins[b].p, expect = p * (double)pooled;
-        double se = sqrt((double)pooled * p * (1.0 - p));
-        double z = se > 0.0 ? (counts[b] - expect) / se : counts[b] - expect;
-        CHECK_MSG(fabs(z) <= MAX_Z, "%s bin %zu: %.0f of %zu, expected %.1f", law->name, b, counts[b],
-                  pooled, expect);
-        max_z = fmax(max_z, fabs(z));
-    }
+    double max_z = law3_tally_check(&tally, law->name);
     fprintf(stderr, "  %s order %d: %d seeds, %zu spheres, min density %.4f, worst overlap %.2g, max |z| %.2f\n",
-            law->name, (int)order, seeds, pooled, min_density, worst_overlap, max_z);
+            law->name, (int)order, seeds, tally.pooled, min_density, worst_overlap, max_z);
 }
 
 static law3 laws[3] = {
@@ -246,7 +183,7 @@ static double uniform(gp_rng *rng, double a, double b)
  * among its solutions, and every solution must be tangent to every member. */
 static void test_tangent(void)
 {
-    gp_box box = {10.0, 11.0, 12.0};
+    gp_box box = {10.0, 11.0, 12.0, 0};
     const double side[3] = {10.0, 11.0, 12.0};
     gp_rng rng;
     gp_rng_seed(&rng, 5);
@@ -334,7 +271,7 @@ static void cancel_at_once(void *ctx, const char *stage, double fraction)
 static void test_bad_inputs(void)
 {
     const gp_distribution *one = &laws[0].spec.dist; /* radius 0.5 */
-    gp_box box = {8, 8, 8};
+    gp_box box = {8, 8, 8, 0};
     gp_pack3d_params p = {&box, one, NULL, 1, 0, GP_PACK3D_LEVEL};
     const double bad_sides[] = {0.0, -1.0, NAN, INFINITY, 0.9 /* under a diameter */};
     for (size_t i = 0; i < sizeof bad_sides / sizeof *bad_sides; i++) {
@@ -344,7 +281,7 @@ static void test_bad_inputs(void)
         CHECK_MSG(refused(&p, GP_EINVAL), "depth %g", bad_sides[i]);
     }
     /* a side of more than 10^6 smallest radii */
-    gp_box huge = {8, 8, 1e7};
+    gp_box huge = {8, 8, 1e7, 0};
     p.box = &huge;
     CHECK(refused(&p, GP_EINVAL));
     p.box = &box;
@@ -366,7 +303,7 @@ static void test_bad_inputs(void)
     gp_error err;
     CHECK(gp_pack3d(&p, &progress, &out, &err) == GP_ECANCELED && out.count == 0 && !out.spheres);
     /* a box of exactly one diameter: one sphere, touching all six walls */
-    gp_box tight = {1.0, 1.0, 1.0};
+    gp_box tight = {1.0, 1.0, 1.0, 0};
     p.box = &tight;
     CHECK(gp_pack3d(&p, NULL, &out, &err) == 0 && out.count == 1);
     gp_packing3d_free(&out);
@@ -375,11 +312,7 @@ static void test_bad_inputs(void)
 
 int main(void)
 {
-    if (load_law(&laws[0], "{\"domain\": {\"width\": 10, \"height\": 10}, \"distribution\": "
-                           "{\"kind\": \"constant\", \"radius\": 0.5}}") ||
-        load_law(&laws[1], "{\"domain\": {\"width\": 10, \"height\": 10}, \"distribution\": "
-                           "{\"kind\": \"uniform\", \"min\": 0.06, \"max\": 0.42}}") ||
-        load_iron(&laws[2]))
+    if (load_laws3(laws))
         return 1;
     RUN(test_tangent);
     RUN(test_properties_level);

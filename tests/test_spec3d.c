@@ -1,5 +1,6 @@
 /* test_spec3d.c - the 3D spec's "balance" and "laguerre" blocks (spec3d.h): the same
- * fields, defaults and 422 pointers as the 2D spec's. */
+ * fields, defaults and 422 pointers as the 2D spec's; the box's "periodic" (2D's shape
+ * with "z"), its minimum side and the stages not yet on periodic boxes. */
 #include <string.h>
 
 #include "check.h"
@@ -33,6 +34,45 @@ static void test_blocks(void)
     gp_spec3d_free(&s);
 }
 
+#define CUBE(periodic) \
+    "\"domain\": {\"width\": 10, \"height\": 10, \"depth\": 10, \"periodic\": " periodic "}, " \
+    "\"distribution\": {\"kind\": \"constant\", \"radius\": 0.5}"
+
+static void test_periodic(void)
+{
+    static const struct {
+        const char *json;
+        unsigned periodic;
+    } good[] = {
+        {"{" BOX "}", 0},
+        {"{" CUBE("false") "}", 0},
+        {"{" CUBE("true") "}", GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z},
+        {"{" CUBE("[]") "}", 0},
+        {"{\"inputs\": {" CUBE("[\"z\"]") "}}", GP_PERIODIC_Z},
+        {"{" CUBE("[\"y\", \"x\"]") "}", GP_PERIODIC_X | GP_PERIODIC_Y},
+    };
+    for (size_t k = 0; k < sizeof good / sizeof good[0]; k++) {
+        gp_spec3d s;
+        gp_error err;
+        int rc = parse(good[k].json, &s, &err);
+        CHECK_MSG(rc == 0, "%s: %s", good[k].json, err.message);
+        CHECK_MSG(rc || s.box.periodic == good[k].periodic, "%s: %u", good[k].json, s.box.periodic);
+        if (!rc)
+            gp_spec3d_free(&s);
+    }
+    /* what the refusals say */
+    gp_spec3d s;
+    gp_error err;
+    CHECK(parse("{" CUBE("[\"x\", \"w\"]") "}", &s, &err) == GP_EINVAL &&
+          strstr(err.message, "\"x\", \"y\" or \"z\""));
+    CHECK(parse("{\"domain\": {\"width\": 10, \"height\": 10, \"depth\": 5.9, \"periodic\": true}, "
+                "\"distribution\": {\"kind\": \"constant\", \"radius\": 0.5}}",
+                &s, &err) == GP_EINVAL &&
+          strstr(err.message, "at least 12 largest packing radii") && strstr(err.message, "depth is 5.9"));
+    CHECK(parse("{" CUBE("true") ", \"laguerre\": {\"shrink\": \"offset\"}}", &s, &err) == GP_EINVAL &&
+          strstr(err.message, "not yet available on periodic boxes"));
+}
+
 static void test_refusals(void)
 {
     static const struct {
@@ -46,6 +86,19 @@ static void test_refusals(void)
         {"{" BOX ", \"laguerre\": {\"shrink\": \"squash\"}}", "/laguerre/shrink"},
         {"{" BOX ", \"laguerre\": {\"shrink\": \"offset\", \"flush_boundary\": 1}}", "/laguerre/flush_boundary"},
         {"{" BOX ", \"mesh\": {}}", "/mesh"},
+        {"{" CUBE("1") "}", "/domain/periodic"},
+        {"{" CUBE("\"x\"") "}", "/domain/periodic"},
+        {"{\"inputs\": {" CUBE("[\"x\", \"w\"]") "}}", "/inputs/domain/periodic/1"},
+        {"{" CUBE("[\"z\", \"z\"]") "}", "/domain/periodic/1"},
+        {"{" CUBE("[\"x\", 2]") "}", "/domain/periodic/1"},
+        /* a periodic side under 12 R_max (6 here); the same side walled is fine */
+        {"{\"inputs\": {\"domain\": {\"width\": 10, \"height\": 5.9, \"depth\": 10, \"periodic\": [\"y\"]}, "
+         "\"distribution\": {\"kind\": \"constant\", \"radius\": 0.5}}}",
+         "/inputs/domain/periodic"},
+        /* balancing and polyhedra: not yet on periodic boxes */
+        {"{\"inputs\": {" CUBE("true") ", \"balance\": {\"method\": \"relocation\"}}}", "/inputs/balance"},
+        {"{\"inputs\": {" CUBE("[\"x\"]") ", \"laguerre\": {\"shrink\": \"offset\"}}}", "/inputs/laguerre"},
+        {"{" CUBE("true") ", \"balance\": {\"method\": \"relocation\"}, \"laguerre\": {\"shrink\": \"offset\"}}", "/balance"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         gp_spec3d s;
@@ -61,5 +114,6 @@ int main(void)
 {
     RUN(test_blocks);
     RUN(test_refusals);
+    RUN(test_periodic);
     return check_status();
 }

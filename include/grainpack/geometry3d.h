@@ -82,7 +82,12 @@ typedef struct gp_cells3d {
  * then shrunk as params asks (offset: every face moved inward by j(r) = R - r, walls
  * included unless flush_boundary; homothetic: about the centre by r / R). Progress as
  * stage "laguerre". Returns 0 and `out` (free with gp_cells3d_free), or GP_ENOMEM,
- * GP_ECANCELED, GP_EGEOM (a centre outside its own cell); `out` zeroed on failure. */
+ * GP_ECANCELED, GP_EGEOM (a centre outside its own cell); `out` zeroed on failure. On a
+ * periodic box (docs/3d.md §11) `rt` is not used (NULL is fine): the cells come from a
+ * triangulation of the spheres and their images near the periodic sides, and a cell
+ * across a side is one polyhedron around its sphere sticking out of the box, its faces'
+ * neighbours grain ids; the power cells then tile the periodic box (power_volume_sum is
+ * its volume). */
 GP_API int gp_laguerre3d(const gp_box *box, const gp_sphere *spheres, size_t n, const gp_rt3 *rt,
                          const gp_laguerre_params *params, const gp_progress *progress,
                          gp_cells3d *out, gp_error *err);

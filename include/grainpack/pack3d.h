@@ -8,6 +8,7 @@
 
 #include "grainpack/api.h"
 #include "grainpack/distribution.h"
+#include "grainpack/domain.h"
 #include "grainpack/error.h"
 #include "grainpack/joint.h"
 #include "grainpack/out.h"
@@ -17,9 +18,15 @@
 extern "C" {
 #endif
 
-/* A box [0, width] x [0, height] x [0, depth] with six walls. */
+/* The third bit of gp_box.periodic, beside domain.h's GP_PERIODIC_X and GP_PERIODIC_Y. */
+#define GP_PERIODIC_Z 4u
+
+/* A box [0, width] x [0, height] x [0, depth]: two walls across each axis, or none along
+ * the axes of `periodic` (docs/3d.md §11: a sphere may cross such a side and is seen by
+ * its images across it; centres are then in [0, side)). */
 typedef struct gp_box {
     double width, height, depth;
+    unsigned periodic; /* GP_PERIODIC_X | GP_PERIODIC_Y | GP_PERIODIC_Z, 0 for six walls */
 } gp_box;
 
 /* A grain: centre (x, y, z), grain radius r and packing radius R = r + j(r). */
@@ -69,9 +76,11 @@ typedef struct gp_packing3d {
 
 /* Checks that the law (with `joint`, NULL for none) can be packed in the box: sides
  * positive and finite, the largest packing sphere inside, the radius ratio at most
- * GP_PACK3D_MAX_RADIUS_RATIO, every side at most GP_PACK_MAX_SIDE_RADII smallest radii.
- * Returns 0 or GP_EINVAL with err set, its pointer relative to a spec's inputs
- * ("/domain/depth", "/distribution"). */
+ * GP_PACK3D_MAX_RADIUS_RATIO, every side at most GP_PACK_MAX_SIDE_RADII smallest radii,
+ * every periodic side at least GP_PACK_MIN_PERIOD_RADII largest packing radii (as in 2D:
+ * only the nearest image of a sphere can then touch another), no periodic bit but the
+ * three axes'. Returns 0 or GP_EINVAL with err set, its pointer relative to a spec's
+ * inputs ("/domain/depth", "/domain/periodic", "/distribution"). */
 GP_API int gp_pack3d_check(const gp_box *box, const gp_distribution *dist, const gp_joint *joint,
                            gp_error *err);
 

@@ -56,7 +56,8 @@ typedef struct gp_result3d {
 /* Runs every stage the spec asks for: the packing, then on one regular triangulation the
  * balancing ("balance", the spheres moved in place) and the polyhedra ("laguerre"). `max_spheres` caps the packing (0: none). On
  * success returns 0 and `result` owns everything in it (free with gp_result3d_free); on
- * failure returns the failing stage's code with err filled, and `result` is zeroed. */
+ * failure returns the failing stage's code with err filled, and `result` is zeroed. A
+ * periodic box with balancing or polyhedra is GP_EINVAL: not yet (docs/3d.md §11). */
 GP_API int gp_pipeline3d_run(const gp_spec3d *spec, size_t max_spheres, const gp_progress *progress,
                              gp_result3d *result, gp_error *err);
 

@@ -13,7 +13,10 @@ jobs: test_service_pack3d_cells.py). A pack3d job too large for
 --max-disks is refused before it is stored, one past --max-job-seconds fails with a time
 limit, a dismissed one stops, and a finished one is deleted with its results. Responses
 are checked against openapi.yaml. The JSON and CSV downloads are byte for byte what
-`grainpack run` writes for the same spec.
+`grainpack run` writes for the same spec. A job in a periodic cube (docs/3d.md §11) runs
+the same way: its spheres overlap no image of another, their centres lie in [0, side),
+some cross a side, and its CSV is the command line's; "periodic" of the wrong shape, a
+periodic side under 12 R_max and balance/laguerre on a periodic box are 422.
 Usage: test_service_pack3d.py GRAINPACKD GRAINPACK"""
 
 import csv
@@ -37,6 +40,8 @@ CONTACT_RTOL = 1e-9
 MAX_SPHERES = 2000000
 BOX = {"width": 12, "height": 10, "depth": 8}
 LAW = {"kind": "uniform", "min": 0.4, "max": 0.8}
+# a cube periodic along all three axes: each side at least 12 R_max (R_max = 0.85)
+PERIODIC_BOX = {"width": 11, "height": 11, "depth": 11, "periodic": True}
 
 
 def spec3d(**inputs):
@@ -62,6 +67,14 @@ def bad_specs():
         ("a shrink that is not one", "pack3d", spec3d(laguerre={"shrink": 2}), "/inputs/laguerre/shrink"),
         ("a sphere larger than the box", "pack3d", big, "/inputs/domain/depth"),
         ("a depth given to pack2d", "pack2d", deep2d, "/inputs/domain/depth"),
+        ("a periodic axis named w", "pack3d", spec3d(domain=dict(BOX, periodic=["x", "w"])),
+         "/inputs/domain/periodic/1"),
+        ("a periodic side under 12 R_max", "pack3d", spec3d(domain=dict(BOX, periodic=["y"])),
+         "/inputs/domain/periodic"),
+        ("balancing on a periodic box", "pack3d",
+         spec3d(domain=dict(PERIODIC_BOX), balance={"method": "relocation"}), "/inputs/balance"),
+        ("polyhedra on a periodic box", "pack3d",
+         spec3d(domain=dict(PERIODIC_BOX), laguerre={"shrink": "offset"}), "/inputs/laguerre"),
     ]
 
 
@@ -137,6 +150,53 @@ def outside(spheres):
     tol = CONTACT_RTOL * max(sides)
     return [s for s in spheres
             if any(s[k] - s[4] < -tol or s[k] + s[4] > sides[k] + tol for k in range(3))]
+
+
+def image_overlaps(spheres, sides):
+    """Pairs overlapping under the minimum image (all pairs: a few hundred spheres)."""
+    bad = []
+    for i, a in enumerate(spheres):
+        for j in range(i + 1, len(spheres)):
+            b = spheres[j]
+            d = [a[k] - b[k] for k in range(3)]
+            d = [v - sides[k] * round(v / sides[k]) for k, v in enumerate(d)]
+            reach = (a[4] + b[4]) * (1 - CONTACT_RTOL)
+            if sum(v * v for v in d) < reach * reach:
+                bad.append((i, j))
+    return bad
+
+
+def check_periodic_job(c, api, client, cli):
+    spec = spec3d(domain=dict(PERIODIC_BOX))
+    r = client.submit(spec, "pack3d")
+    api.check(c, "POST", "/processes/{processId}/execution", r)
+    job = r.json()["jobID"]
+    info = client.wait_final(job)
+    if not c.check(info["status"] == "successful", f"the periodic pack3d job: {info}"):
+        return
+    st = client.get(f"/jobs/{job}/statistics").json()
+    r = client.get(f"/jobs/{job}/results?f=csv")
+    header, spheres = read_csv(r.body)
+    sides = (PERIODIC_BOX["width"], PERIODIC_BOX["height"], PERIODIC_BOX["depth"])
+    c.check(len(spheres) == st["count"] > 100, f"periodic csv: {len(spheres)} spheres, {st['count']}")
+    c.check(not image_overlaps(spheres, sides), f"periodic: overlapping images {image_overlaps(spheres, sides)[:5]}")
+    c.check(all(0 <= s[k] < sides[k] for s in spheres for k in range(3)), "a periodic centre outside [0, side)")
+    c.check(any(s[k] < s[4] or s[k] > sides[k] - s[4] for s in spheres for k in range(3)),
+            "no sphere crosses a periodic side")
+    density = sum(4 / 3 * math.pi * s[4] ** 3 for s in spheres) / (sides[0] * sides[1] * sides[2])
+    c.check(abs(density - st["packing_density"]) < 1e-12, f"periodic density {density}, {st['packing_density']}")
+    doc = client.get(f"/jobs/{job}/results?f=json").json()
+    c.check(doc["inputs"]["domain"] == dict(PERIODIC_BOX, periodic=["x", "y", "z"]),
+            f"the JSON download's domain: {doc['inputs']['domain']}")
+    for fmt, mark in (("svg", b"<svg"), ("vtu", b"<VTKFile")):
+        r = client.get(f"/jobs/{job}/results?f={fmt}")
+        c.check(r.status == 200 and mark in r.body[:400], f"the periodic job's {fmt}: {r.status}")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "cube.json")
+        with open(path, "w") as f:
+            json.dump(spec, f)
+        made = subprocess.run([cli, "run", path, "-f", "csv"], capture_output=True, check=True).stdout
+        c.check(made == plain_csv(client, job), "the periodic CSV download is not grainpack run's")
 
 
 def pipeline_runs(client):
@@ -250,6 +310,7 @@ def test(c, binary, cli):
         check_refusals(c, api, client)
         check_validation(c, api, client)
         check_job(c, api, client, cli)
+        check_periodic_job(c, api, client, cli)
         check_limits(c, client)
         c.check(daemon.stop() == 0, "grainpackd did not stop cleanly")
         gpd.check_store(c, daemon, "after the pack3d jobs")
