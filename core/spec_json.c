@@ -77,6 +77,20 @@ static json_t *mesh_json(const gp_spec *spec, int *failed)
     return o;
 }
 
+/* "periodic" on domain `o`, as the spec's list form (["x"], ["x", "z"], ...), when any of
+ * the first `naxes` axes is periodic (bit a: axis a); a walled domain writes nothing. */
+static void put_periodic(json_t *o, unsigned periodic, int naxes, int *failed)
+{
+    static const char *const axes[] = {"x", "y", "z"};
+    if (!(periodic & ((1u << naxes) - 1u)))
+        return;
+    json_t *list = json_array();
+    for (int a = 0; a < naxes; a++)
+        if (((periodic >> a) & 1u) && (!list || json_array_append_new(list, json_string(axes[a]))))
+            *failed = 1;
+    put(o, "periodic", list, failed);
+}
+
 /* The "balance" and "laguerre" blocks, the same in 2D and 3D specs: every field spelled out,
  * defaults included, so that the inputs a result carries run again to the same result. */
 static json_t *balance_json(const gp_balance_params *b)
@@ -95,8 +109,9 @@ json_t *gp_spec_json(const gp_spec *spec)
 {
     int failed = 0;
     json_t *in = json_object();
-    put(in, "domain", json_pack("{s:f, s:f}", "width", spec->domain.width, "height",
-                                spec->domain.height), &failed);
+    json_t *domain = json_pack("{s:f, s:f}", "width", spec->domain.width, "height", spec->domain.height);
+    put_periodic(domain, spec->domain.periodic, 2, &failed);
+    put(in, "domain", domain, &failed);
     put(in, "distribution", gp_json_distribution(&spec->dist, &failed), &failed);
     put(in, "joint", gp_json_joint(&spec->joint, &failed), &failed);
     put(in, "seed", json_integer((json_int_t)spec->seed), &failed);
@@ -123,15 +138,8 @@ json_t *gp_spec_json(const gp_spec *spec)
 /* A 3D spec's "domain": width, height, depth, and "periodic" (["x", "z"], ...) when any. */
 static json_t *json_box(const gp_box *box, int *failed)
 {
-    static const char *const axes[] = {"x", "y", "z"};
     json_t *o = json_pack("{s:f, s:f, s:f}", "width", box->width, "height", box->height, "depth", box->depth);
-    if (box->periodic) { /* as the list form of the spec; a walled box writes nothing more */
-        json_t *list = json_array();
-        for (int a = 0; a < 3; a++)
-            if (((box->periodic >> a) & 1u) && (!list || json_array_append_new(list, json_string(axes[a]))))
-                *failed = 1;
-        put(o, "periodic", list, failed);
-    }
+    put_periodic(o, box->periodic, 3, failed);
     return o;
 }
 

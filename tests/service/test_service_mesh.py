@@ -140,6 +140,10 @@ def check_periodic(c, client, cli, tmp):
     bytes, has the $Periodic section that meshio reads (test_mesh_readers has Gmsh's
     reading of it)."""
     spec = periodic_spec(element_size=4)
+    # the service's reading of the spec keeps the periodic sides (it dropped them)
+    echoed = client.post_json("/processes/pack2d/validation", spec).json().get("inputs", {})
+    c.check(echoed.get("domain", {}).get("periodic") == ["x", "y"],
+            f"validation's normalised domain of a periodic spec: {echoed.get('domain')}")
     r = client.submit(spec)
     c.check(r.status == 201, f"a periodic spec with a mesh: {r}")
     info = client.wait_final(r.json()["jobID"])
