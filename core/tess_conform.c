@@ -128,7 +128,8 @@ static int find_splits(const tess_faces *tf, double tol, split **out, size_t *no
             rc = GP_ENOMEM;
             break;
         }
-        qsort(edges, (size_t)n, sizeof *edges, pair_cmp);
+        if (n > 0) /* qsort's array must not be NULL, even empty */
+            qsort(edges, (size_t)n, sizeof *edges, pair_cmp);
         size_t once = 0; /* the once-used edges, moved to the front */
         for (size_t k = 0, j; k < (size_t)n; k = j) {
             for (j = k + 1; j < (size_t)n && !pair_cmp(&edges[j], &edges[k]); j++)
@@ -160,7 +161,8 @@ static int find_splits(const tess_faces *tf, double tol, split **out, size_t *no
         free(splits);
         return rc;
     }
-    qsort(splits, n_splits, sizeof *splits, split_cmp);
+    if (n_splits) /* none at all is the rule: splits is then NULL */
+        qsort(splits, n_splits, sizeof *splits, split_cmp);
     size_t kept = 0;
     for (size_t k = 0; k < n_splits; k++)
         if (!kept || splits[k].lo != splits[kept - 1].lo || splits[k].hi != splits[kept - 1].hi ||
