@@ -160,18 +160,6 @@ static json_t *cells_json(const gp_spec *spec, const gp_cell_stats *c, int *fail
     return o;
 }
 
-/* The periodic axes, as the spec's list form: ["x"], ["y"] or ["x", "y"] (NULL if out of
- * memory, which put reports). */
-static json_t *periodic_json(unsigned periodic)
-{
-    json_t *axes = json_array();
-    if (axes && (periodic & GP_PERIODIC_X))
-        json_array_append_new(axes, json_string("x"));
-    if (axes && (periodic & GP_PERIODIC_Y))
-        json_array_append_new(axes, json_string("y"));
-    return axes;
-}
-
 json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
 {
     const gp_pack_stats *st = &result->stats;
@@ -209,7 +197,7 @@ json_t *gp_statistics_json(const gp_spec *spec, const gp_result *result)
     put(root, "front", front, &failed);
     put(root, "seed", json_integer((json_int_t)spec->seed), &failed);
     if (spec->domain.periodic)
-        put(root, "periodic", periodic_json(spec->domain.periodic), &failed);
+        put(root, "periodic", gp_json_periodic(spec->domain.periodic, 2, &failed), &failed);
     if (result->has_balance)
         put(root, "balance", gp_json_balance(&result->balance, &failed), &failed);
     if (result->has_cells)

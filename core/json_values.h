@@ -41,7 +41,8 @@ void gp_out_json_F(gp_out *out, double F);
 json_t *gp_spec_json(const gp_spec *spec);
 
 /* The same for a 3D spec: domain (with its depth, and "periodic" as a list of axes when
- * the box has any), distribution, joint, seed. */
+ * the box has any), distribution, joint, seed, the balance and laguerre blocks when asked
+ * for, picture. */
 json_t *gp_spec3d_json(const gp_spec3d *spec);
 
 /* Parts of the above that the 3D writers share (NULL or *failed set when out of memory):
@@ -52,6 +53,9 @@ json_t *gp_json_counts(const size_t *counts, size_t n, int *failed);
 json_t *gp_json_balance(const gp_balance_result *b, int *failed);
 json_t *gp_json_distribution(const gp_distribution *d, int *failed);
 json_t *gp_json_joint(const gp_joint *j, int *failed);
+/* The periodic axes among the first `naxes` (bit a: axis a) as the spec's list form:
+ * ["x"], ["x", "z"], ... */
+json_t *gp_json_periodic(unsigned periodic, int naxes, int *failed);
 /* The polyhedra's statistics as the 3D JSON writes them under "cells" (count, shrink,
  * faces, vertices, volume, faces_per_cell, ...): reads cells->shrink and `stats` only, so
  * a summary decoded from the store serves as well. */

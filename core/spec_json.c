@@ -77,18 +77,22 @@ static json_t *mesh_json(const gp_spec *spec, int *failed)
     return o;
 }
 
-/* "periodic" on domain `o`, as the spec's list form (["x"], ["x", "z"], ...), when any of
- * the first `naxes` axes is periodic (bit a: axis a); a walled domain writes nothing. */
-static void put_periodic(json_t *o, unsigned periodic, int naxes, int *failed)
+json_t *gp_json_periodic(unsigned periodic, int naxes, int *failed)
 {
     static const char *const axes[] = {"x", "y", "z"};
-    if (!(periodic & ((1u << naxes) - 1u)))
-        return;
     json_t *list = json_array();
     for (int a = 0; a < naxes; a++)
         if (((periodic >> a) & 1u) && (!list || json_array_append_new(list, json_string(axes[a]))))
             *failed = 1;
-    put(o, "periodic", list, failed);
+    return list;
+}
+
+/* "periodic" on domain `o` when any of its first `naxes` axes is; a walled domain writes
+ * nothing. */
+static void put_periodic(json_t *o, unsigned periodic, int naxes, int *failed)
+{
+    if (periodic & ((1u << naxes) - 1u))
+        put(o, "periodic", gp_json_periodic(periodic, naxes, failed), failed);
 }
 
 /* The "balance" and "laguerre" blocks, the same in 2D and 3D specs: every field spelled out,
